@@ -1,0 +1,37 @@
+# beamfx: Debian 12 + apt DOLFINx 0.5.2. `make run` / `make test` install everything first.
+SHELL := /bin/bash
+VENV  := .venv
+PY    := $(VENV)/bin/python
+MPIRUN := mpirun --allow-run-as-root --oversubscribe -n 2
+
+export SETUPTOOLS_USE_DISTUTILS := stdlib
+export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+export PYTHONUNBUFFERED := 1
+
+.PHONY: install run test test-slow bench lint clean
+
+install:
+	bash scripts/install.sh
+
+run: install
+	$(VENV)/bin/beamfx run
+
+test: install
+	$(PY) -m pytest -n 2 -m "not slow and not mpi" tests
+	$(MPIRUN) $(PY) -m pytest -p no:cacheprovider -m mpi tests/; rc=$$?; \
+	  if [ $$rc -eq 5 ]; then echo "(no MPI tests collected)"; rc=0; fi; exit $$rc
+
+test-slow: install
+	$(PY) -m pytest -m slow tests
+
+bench: install
+	$(VENV)/bin/beamfx bench --report docs/validation
+
+lint: install
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+
+clean:
+	rm -rf $(VENV) build dist *.egg-info .pytest_cache .ruff_cache
+	find . -name __pycache__ -type d -prune -not -path './.git/*' -exec rm -rf {} +

@@ -1,0 +1,102 @@
+"""Plain descriptions of a beam model: what the scene file says, as frozen dataclasses."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..physics.kinematics import Kinematics
+from ..physics.sections import Section
+
+DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+
+
+@dataclass(frozen=True)
+class Beam:
+    name: str
+    curve: object
+    section: Section
+    elements: int
+    degree: int = 2
+    orientation: tuple | None = None  # reference vector for the section z axis (global)
+    twist_deg: float = 0.0
+
+
+@dataclass(frozen=True)
+class Support:
+    """Fixed dofs (names from :data:`DOF_NAMES`, global axes) at a point.
+
+    ``displacement`` and ``rotation`` (a rotation vector, global axes) are prescribed values,
+    applied with the load factor; zero by default.
+    """
+
+    at: str
+    fix: tuple
+    displacement: tuple = (0.0, 0.0, 0.0)
+    rotation: tuple = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PointLoad:
+    at: str
+    force: tuple = (0.0, 0.0, 0.0)
+    moment: tuple = (0.0, 0.0, 0.0)
+    follower: bool = False
+
+
+@dataclass(frozen=True)
+class DistributedLoad:
+    """Force and moment per unit reference length on ``beam`` (all beams if None)."""
+
+    beam: str | None = None
+    force: tuple = (0.0, 0.0, 0.0)
+    moment: tuple = (0.0, 0.0, 0.0)
+    follower: bool = False
+
+
+@dataclass(frozen=True)
+class Spring:
+    at: str
+    stiffness: tuple  # translational spring to ground, per global axis
+
+
+@dataclass(frozen=True)
+class Model:
+    beams: tuple
+    supports: tuple = ()
+    point_loads: tuple = ()
+    distributed_loads: tuple = ()
+    springs: tuple = ()
+    gravity: tuple = (0.0, 0.0, 0.0)
+    kinematics: Kinematics = field(default_factory=Kinematics)
+
+    def beam(self, name):
+        for b in self.beams:
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+
+def resolve_point(model, at):
+    """Beam index, arc length and coordinates of a point name ``beam:start|end|<fraction>``.
+
+    Raises:
+        ValueError: with the allowed forms, if ``at`` names no point of a beam.
+    """
+    names = [b.name for b in model.beams]
+    beam_name, _, where = str(at).partition(":")
+    if beam_name not in names:
+        raise ValueError(f"{at!r} names no beam; beams are {names} (write 'beam:start', "
+                         "'beam:end' or 'beam:<fraction of length>')")
+    b = names.index(beam_name)
+    L = model.beams[b].curve.length
+    if where in ("start", "end"):
+        s = 0.0 if where == "start" else L
+    else:
+        try:
+            f = float(where)
+        except ValueError:
+            raise ValueError(f"{at!r}: after ':' write start, end or a fraction in [0, 1]") from None
+        if not 0.0 <= f <= 1.0:
+            raise ValueError(f"{at!r}: the fraction must lie in [0, 1]")
+        s = f * L
+    return b, s, np.asarray(model.beams[b].curve.points([s])[0], float)

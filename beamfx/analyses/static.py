@@ -1,0 +1,73 @@
+"""Static analyses: nonlinear with adaptive load stepping, and linear (one solve)."""
+
+import time
+from typing import NamedTuple
+
+import numpy as np
+
+from ..solvers import NewtonSolver, step_load
+
+
+class StaticResult(NamedTuple):
+    steps: tuple  # accepted LoadStep records
+    newton_iterations: int
+    seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, total
+
+
+class _State:
+    """Save/restore of the unknowns for cut-backs."""
+
+    def __init__(self, w):
+        self.w, self.saved = w, w.x.array.copy()
+
+    def save(self):
+        self.saved[:] = self.w.x.array
+
+    def restore(self):
+        self.w.x.array[:] = self.saved
+        self.w.x.scatter_forward()
+
+
+def load_scale(model, F):
+    """Norm of the external load vector at full load (compiled residual ``F`` at the undeformed
+    state), to set an absolute residual tolerance in the problem's units."""
+    import dolfinx.fem.petsc as fp
+    from petsc4py import PETSc
+
+    lam, w0 = float(model.load_factor.value), model.w.x.array.copy()
+    model.reset()
+    model.set_load_factor(1.0)
+    b = fp.assemble_vector(F)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    fp.set_bc(b, model.bcs, scale=0.0)
+    norm = b.norm()
+    b.destroy()
+    model.w.x.array[:] = w0
+    model.set_load_factor(lam)
+    return norm
+
+
+def solve_static(model, steps=10, options=None, prefix="beamfx_static_", on_step=None, log=None,
+                 solver=None):
+    """Nonlinear static equilibrium at load factor 1, reached by adaptive load stepping.
+
+    The linear kinematics take a single step (the problem is linear). Newton's absolute
+    tolerance is 1e-10 of the load vector's norm.
+    """
+    t0 = time.perf_counter()
+    from ..solvers.forms import compile_seconds
+
+    c0 = compile_seconds[0]
+    solver = solver or NewtonSolver(model.F, model.J, model.w, model.bcs, prefix, options)
+    scale = load_scale(model, solver.F)
+    solver.set_atol(max(1e-10 * scale, 1e-14))
+    compile_time = compile_seconds[0] - c0
+
+    def solve_at(lam):
+        model.set_load_factor(lam)
+        return solver.solve()
+
+    n = 1 if not model.kin.finite else steps
+    history = step_load(solve_at, _State(model.w), steps=n, on_step=on_step, log=log)
+    seconds = {"compile": compile_time, **solver.seconds, "total": time.perf_counter() - t0}
+    return StaticResult(tuple(history), int(np.sum([h.iterations for h in history])), seconds)

@@ -1,0 +1,130 @@
+"""Interval meshes of one or more beams embedded in 3D, with named points.
+
+Beams that share a point (within a tolerance) share the mesh vertex there: the joint is rigid
+because displacement and rotation are continuous fields. Only rank 0 builds the node list;
+DOLFINx distributes the cells.
+"""
+
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+
+@dataclass(frozen=True)
+class BeamSpec:
+    """One beam of a model: a curve, its element count and the arc lengths that need vertices."""
+
+    name: str
+    curve: object
+    elements: int
+    breaks: tuple = ()  # arc lengths of named points inside the beam
+    cell_data: dict = field(default_factory=dict)  # per-beam values copied to its cells
+
+
+class BeamMesh(NamedTuple):
+    mesh: object  # dolfinx.mesh.Mesh, P_k geometry
+    degree: int
+    specs: tuple
+    cell_beam: np.ndarray  # beam index of each local cell (with ghosts)
+    cell_span: np.ndarray  # (n_local_cells, 2): arc lengths (s_a, s_b) of each cell in its beam
+    point_tags: object  # dolfinx MeshTags on vertices, value = point id
+    points: dict  # name -> (id, xyz)
+
+
+def _element_breaks(spec):
+    """Arc lengths of all cell vertices of one beam: kinks and breaks are vertices."""
+    L = spec.curve.length
+    cuts = sorted({0.0, L, *spec.curve.kinks, *spec.breaks})
+    cuts = [c for i, c in enumerate(cuts) if i == 0 or c - cuts[i - 1] > 1e-12 * L]
+    spans = np.diff(cuts)
+    n = np.maximum(1, np.round(spans / L * spec.elements)).astype(int)
+    while n.sum() > max(spec.elements, len(spans)):  # keep the requested total
+        n[np.argmax(n / spans)] -= 1
+    while n.sum() < spec.elements:
+        n[np.argmax(spans / n)] += 1
+    return np.concatenate(
+        [np.linspace(a, b, k + 1)[:-1] for a, b, k in zip(cuts[:-1], cuts[1:], n)] + [[L]]
+    )
+
+
+def _nodes_and_cells(specs, degree, tol):
+    """Rank-0 node coordinates, cells (DOLFINx order), beam of each cell and its (s_a, s_b)."""
+    pts, cells, beam_of, spans = [], [], [], []
+    vertex_ids = {}  # rounded coordinate -> node index, merges shared vertices
+
+    def vertex(x):
+        key = tuple(np.round(np.asarray(x) / tol).astype(np.int64))
+        if key not in vertex_ids:
+            vertex_ids[key] = len(pts)
+            pts.append(x)
+        return vertex_ids[key]
+
+    for b, spec in enumerate(specs):
+        s_v = _element_breaks(spec)
+        for sa, sb in zip(s_v[:-1], s_v[1:]):
+            local = np.linspace(sa, sb, degree + 1)
+            xyz = spec.curve.points(local)
+            ends = [vertex(xyz[0]), vertex(xyz[-1])]
+            inner = list(range(len(pts), len(pts) + degree - 1))
+            pts.extend(xyz[1:-1])
+            cells.append(ends + inner)
+            beam_of.append(b)
+            spans.append((sa, sb))
+    return np.array(pts, float), np.array(cells, np.int64), np.array(beam_of), np.array(spans)
+
+
+def build_mesh(comm, specs, degree, named_points=None):
+    """Mesh of all beams with isoparametric P_degree geometry on the exact curves.
+
+    Args:
+        comm: MPI communicator.
+        specs: sequence of :class:`BeamSpec`.
+        degree: polynomial degree of the geometry (and of the fields built on it).
+        named_points: ``{name: xyz}`` of points that must be mesh vertices (probes, loads).
+
+    Returns:
+        :class:`BeamMesh`.
+    """
+    import dolfinx
+
+    size = max(np.ptp(np.vstack([s.curve.points([0, s.curve.length]) for s in specs])), 1.0)
+    tol = 1e-9 * size
+    if comm.rank == 0:
+        x, cells, beam_of, spans = _nodes_and_cells(specs, degree, tol)
+    else:
+        x, cells = np.empty((0, 3)), np.empty((0, degree + 1), np.int64)
+        beam_of, spans = None, None
+    beam_of, spans = comm.bcast((beam_of, spans), root=0)
+
+    cell = ufl.Cell("interval", geometric_dimension=3)
+    # variant="equispaced": FFCx would set it anyway and then miss the JIT cache (notes, P5)
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, degree, variant="equispaced"))
+    mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain)
+
+    original = np.asarray(mesh.topology.original_cell_index)
+    tdim = mesh.topology.dim
+    n_local = mesh.topology.index_map(tdim).size_local + mesh.topology.index_map(tdim).num_ghosts
+    original = original[:n_local]
+
+    named_points = dict(named_points or {})
+    ids, vertices, values = {}, [], []
+    for i, (name, xyz) in enumerate(named_points.items(), start=1):
+        xyz = np.asarray(xyz, float)
+        found = dolfinx.mesh.locate_entities(
+            mesh, 0, lambda X, p=xyz: np.linalg.norm(X.T - p, axis=1) < 1e3 * tol
+        )
+        if comm.allreduce(len(found), op=MPI.SUM) == 0:
+            raise ValueError(f"point {name!r} at {xyz.tolist()} is on no beam")
+        ids[name] = (i, xyz)
+        vertices.append(found)
+        values.append(np.full(len(found), i, np.int32))
+    if vertices:
+        v = np.concatenate(vertices)
+        order = np.argsort(v)
+        point_tags = dolfinx.mesh.meshtags(mesh, 0, v[order].astype(np.int32), np.concatenate(values)[order])
+    else:
+        point_tags = dolfinx.mesh.meshtags(mesh, 0, np.empty(0, np.int32), np.empty(0, np.int32))
+    return BeamMesh(mesh, degree, tuple(specs), beam_of[original], spans[original], point_tags, ids)

@@ -1,0 +1,117 @@
+"""Rotations in UFL and NumPy: hat/axial maps and the quaternion rotation.
+
+Quaternions are ``(q0, q1, q2, q3)`` with scalar part first. ``R(q)`` maps section (body) vectors
+to global (spatial) vectors.
+"""
+
+import numpy as np
+import ufl
+
+
+def hat(v):
+    """Skew matrix with ``hat(v) @ a = v × a``."""
+    return ufl.as_matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def axial(A):
+    """Inverse of :func:`hat` applied to the skew part of ``A``."""
+    return ufl.as_vector([A[2, 1] - A[1, 2], A[0, 2] - A[2, 0], A[1, 0] - A[0, 1]]) / 2
+
+
+def quaternion_vector(q):
+    """Vector part of the quaternion ``q``."""
+    return ufl.as_vector([q[1], q[2], q[3]])
+
+
+def rotation(q):
+    r"""Rotation matrix of a quaternion of any norm.
+
+    :math:`R(q) = [(q_0^2 - v\cdot v) I + 2 v v^T + 2 q_0 \hat v] / |q|^2`
+    (e.g. Géradin & Cardona 2001, eq. 4.53, divided by the norm so that it is a rotation for
+    every non-zero ``q``).
+    """
+    v = quaternion_vector(q)
+    q0 = q[0]
+    return ((q0**2 - ufl.dot(v, v)) * ufl.Identity(3) + 2 * ufl.outer(v, v) + 2 * q0 * hat(v)) / (
+        ufl.dot(q, q)
+    )
+
+
+def body_rate(q, dq):
+    r"""Body-frame rate :math:`\mathrm{axial}(R^T \delta R) = 2\,\mathrm{Im}(\bar q\,\delta q)/|q|^2`.
+
+    With ``dq = q'`` this is the curvature of the rotation field; with ``dq`` a variation it is
+    the virtual rotation in body axes. Independent of a (pointwise) scaling of ``q``.
+    """
+    v, dv = quaternion_vector(q), quaternion_vector(dq)
+    return 2 * (q[0] * dv - dq[0] * v - ufl.cross(v, dv)) / ufl.dot(q, q)
+
+
+def spatial_rate(q, dq):
+    r"""Spatial rate :math:`\mathrm{axial}(\delta R\, R^T) = 2\,\mathrm{Im}(\delta q\,\bar q)/|q|^2`."""
+    v, dv = quaternion_vector(q), quaternion_vector(dq)
+    return 2 * (q[0] * dv - dq[0] * v + ufl.cross(v, dv)) / ufl.dot(q, q)
+
+
+# --- NumPy counterparts, for set-up and post-processing --------------------------------------
+
+
+def np_hat(v):
+    """NumPy :func:`hat`."""
+    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def np_rotation(q):
+    """NumPy :func:`rotation` for one quaternion or an array of shape (n, 4)."""
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 2:
+        return np.array([np_rotation(qi) for qi in q])
+    q0, v = q[0], q[1:]
+    return ((q0**2 - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * q0 * np_hat(v)) / (q @ q)
+
+
+def np_quaternion(axis, angle):
+    """Unit quaternion of a rotation by ``angle`` about ``axis``."""
+    axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    return np.r_[np.cos(angle / 2), np.sin(angle / 2) * axis]
+
+
+def axis_angle(q):
+    """Axis and angle in [0, 2π] of a quaternion (the angle the quaternion itself encodes).
+
+    Unlike a rotation matrix, a continuous quaternion field remembers full turns modulo 4π:
+    ``q`` and ``-q`` are the same rotation but angles φ and 4π - φ... here reported in [0, 2π]
+    with the axis flipped as needed, see :func:`unwrap_angle` to follow a load path.
+    """
+    q = np.asarray(q, dtype=float)
+    q = q / np.linalg.norm(q)
+    s = np.linalg.norm(q[1:])
+    angle = 2 * np.arctan2(s, q[0])  # in [0, 2π]
+    axis = q[1:] / s if s > 1e-300 else np.array([1.0, 0.0, 0.0])
+    return axis, angle
+
+
+def principal_rotation_vector(q):
+    """Rotation vector with |θ| ≤ π of the rotation encoded by ``q``."""
+    axis, angle = axis_angle(q)
+    if angle > np.pi:
+        axis, angle = -axis, 2 * np.pi - angle
+    return angle * axis
+
+
+def unwrap_rotation_vector(q, previous):
+    """Rotation vector of ``q`` closest to ``previous`` among all 2π-equivalent ones.
+
+    Used to follow a rotation past π, 2π, 4π along a load or time path: the candidate
+    ``(φ + 2πk) n`` (and with -n) nearest to the previous value is kept.
+    """
+    axis, angle = axis_angle(q)
+    prev = np.asarray(previous, dtype=float)
+    k0 = int(np.round(np.linalg.norm(prev) / (2 * np.pi)))
+    candidates = [
+        sgn * (angle + 2 * np.pi * k) * axis
+        for sgn in (1, -1)
+        for k in range(k0 - 2, k0 + 3)
+    ]
+    return min(candidates, key=lambda c: np.linalg.norm(c - prev))

@@ -1,0 +1,70 @@
+"""Adaptive load stepping: cut back and retry a failed step, grow after easy steps."""
+
+from typing import NamedTuple
+
+from .snes import SolveFailed
+
+
+class LoadStep(NamedTuple):
+    step: int
+    load_factor: float
+    iterations: int
+    residuals: tuple
+    cutbacks: int
+
+
+def step_load(solve_at, state, steps=10, min_fraction=1e-4, easy_iterations=4, growth=1.5,
+              on_step=None, log=None):
+    """March the load factor from 0 to 1.
+
+    Args:
+        solve_at: ``solve_at(load_factor) -> SolveReport``; starts from the current state.
+        state: object with ``save()`` and ``restore()`` of the unknowns, used on failure.
+        steps: initial number of equal steps (the first step is 1/steps).
+        min_fraction: smallest step allowed, as a fraction of the total load.
+        easy_iterations: a step that converged in at most this many iterations lets the next
+            step grow by ``growth`` (never beyond the initial step size).
+        on_step: called with each accepted :class:`LoadStep` (to write output as it goes).
+        log: callable for one-line progress messages.
+
+    Returns:
+        list of accepted :class:`LoadStep`.
+
+    Raises:
+        SolveFailed: naming the step, the load factor, its residual history and the cut-backs.
+    """
+    nominal = 1.0 / steps
+    size, lam, history, tried = nominal, 0.0, [], []
+    while lam < 1.0 - 1e-14:
+        target = min(1.0, lam + size)
+        state.save()
+        report = solve_at(target)
+        if report.converged:
+            item = LoadStep(len(history) + 1, target, report.iterations, report.residuals, len(tried))
+            history.append(item)
+            if log:
+                log(f"step {item.step}: load factor {target:.6g}, {report.iterations} Newton "
+                    f"iterations, |F| {report.residuals[-1] if report.residuals else 0:.3e}")
+            if on_step:
+                on_step(item)
+            lam, tried = target, []
+            if report.iterations <= easy_iterations:
+                size = min(nominal, size * growth)
+            continue
+        state.restore()
+        tried.append((target, report.reason, report.residuals))
+        if log:
+            log(f"step {len(history) + 1}: no convergence at load factor {target:.6g} "
+                f"({report.reason}); cutting the step back")
+        size /= 2
+        if size < min_fraction:
+            lines = "\n".join(
+                f"  load factor {t:.6g}: {r}, |F| = " + ", ".join(f"{x:.3e}" for x in res)
+                for t, r, res in tried
+            )
+            raise SolveFailed(
+                f"Newton failed at step {len(history) + 1} after {len(tried)} attempts, the "
+                f"last converged load factor is {lam:.6g}; tried:\n{lines}",
+                history,
+            )
+    return history
