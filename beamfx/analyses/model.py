@@ -41,7 +41,7 @@ class BeamModel:
     ``bcs``, ``C_N``/``C_M``/``Lam0`` (UFL), ``points`` (name -> (tag, xyz)).
     """
 
-    def __init__(self, model, comm=MPI.COMM_WORLD):
+    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=()):
         from dolfinx import fem
         from petsc4py import PETSc
 
@@ -52,8 +52,8 @@ class BeamModel:
         self.degree = p = degrees.pop()
 
         # named points: every 'at' of supports, loads, springs and probes becomes a vertex
-        ats = {x.at for x in (*model.supports, *model.point_loads, *model.springs)}
-        self.named = {at: resolve_point(model, at) for at in ats}
+        ats = [x.at for x in (*model.supports, *model.point_loads, *model.springs)] + list(extra_points)
+        self.named = {at: resolve_point(model, at) for at in dict.fromkeys(ats)}
         breaks = {i: [] for i in range(len(model.beams))}
         for b, s, _ in self.named.values():
             breaks[b].append(s)

@@ -1,0 +1,229 @@
+"""Read a TOML scene into a :class:`~beamfx.analyses.spec.Model` plus analysis settings.
+
+The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, ``GA_y``,
+``EI_y``, ``angle_deg``, ``start_tangent``, ...). See docs/scenes.md for every key.
+"""
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..analyses.spec import DOF_NAMES, Beam, DistributedLoad, Model, PointLoad, Spring, Support
+from ..geometry import curves
+from ..physics import sections
+from ..physics.kinematics import Kinematics
+from .table import SceneError, Table
+
+CURVE_SHAPES = ("line", "arc", "helix", "polyline", "spline", "gmsh")
+SECTION_TYPES = ("rectangle", "circle", "tube", "general")
+ANALYSES = ("static", "linear_static")
+FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A parsed scene: the model and how to analyse and report it."""
+
+    file: str
+    model: Model
+    analysis: str = "static"
+    steps: int = 10
+    probes: dict = field(default_factory=dict)  # name -> point ("beam:end")
+    output_dir: str = "results"
+    solver_options: dict = field(default_factory=dict)
+
+
+def _curve(t, base):
+    shape = t.get("shape", str, choices=CURVE_SHAPES)
+    if shape == "line":
+        start = t.get("start", "vec3")
+        if t.has("end"):
+            end = t.get("end", "vec3")
+        else:
+            d, L = t.get("direction", "vec3"), t.get("length", float, positive=True)
+            n = sum(x * x for x in d) ** 0.5 or t.fail("direction", "must not be zero")
+            end = tuple(s + L * x / n for s, x in zip(start, d))
+        c = curves.Line(start, end)
+    elif shape == "arc":
+        c = curves.Arc(t.get("start", "vec3"), t.get("start_tangent", "vec3"), t.get("centre", "vec3"),
+                       t.get("angle_deg", float, positive=True))
+        if c.radius == 0:
+            t.fail("centre", "must differ from start (zero radius)")
+    elif shape == "helix":
+        c = curves.Helix(t.get("centre", "vec3"), t.get("axis", "vec3"), t.get("radius", float, positive=True),
+                         t.get("pitch", float), t.get("turns", float, positive=True),
+                         t.get("start_direction", "vec3", (1.0, 0.0, 0.0)))
+    elif shape in ("polyline", "spline"):
+        pts = t.get("points", list)
+        if len(pts) < 2 or not all(isinstance(p, list) and len(p) == 3 for p in pts):
+            t.fail("points", "expected a list of at least two [x, y, z] points")
+        pts = tuple(tuple(float(x) for x in p) for p in pts)
+        c = curves.Polyline(pts) if shape == "polyline" else curves.SampledCurve(pts)
+    else:
+        f = base / t.get("file", str)
+        if not f.exists():
+            t.fail("file", f"no such file: {f}")
+        c = curves.curve_from_gmsh(f, t.get("curve_tag", int, None))
+    t.done()
+    if not c.length > 0:
+        raise SceneError(f"{t.where('')[:-1]}: zero-length curve")
+    return c
+
+
+def _section(t, mat):
+    kind = t.get("type", str, choices=SECTION_TYPES)
+    k = t.get("shear_factor", float, None, positive=True)
+    if kind == "general":
+        vals = {key: t.get(key, float, positive=True) for key in ("EA", "GA_y", "GA_z", "GJ", "EI_y", "EI_z")}
+        rho_A = t.get("rho_A", float, 0.0)
+        rho_I = t.get("rho_I", "vec3", (0.0, 0.0, 0.0))
+        t.done()
+        return sections.Section(**vals, rho_A=rho_A, rho_I=rho_I)
+    if mat is None:
+        t.fail("type", "a geometric section needs the [material] table (E, nu, rho)")
+    E, G, rho, nu = mat
+    if kind == "rectangle":
+        torsion = t.get("torsion", (str, float, int), "saint-venant")
+        if isinstance(torsion, str) and torsion not in ("saint-venant", "thin-strip"):
+            t.fail("torsion", f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J")
+        s = sections.rectangle(E, G, rho, t.get("h", float, positive=True), t.get("w", float, positive=True),
+                               torsion, k, nu)
+    elif kind == "circle":
+        s = sections.tube(E, G, rho, t.get("d", float, positive=True), 0.0, k, nu)
+    else:
+        d = t.get("d", float, positive=True)
+        di = t.get("d_inner", float)
+        if not 0 <= di < d:
+            t.fail("d_inner", f"must satisfy 0 <= d_inner < d = {d}")
+        s = sections.tube(E, G, rho, d, di, k, nu)
+    t.done()
+    return s
+
+
+def _material(t):
+    if t is None:
+        return None
+    E = t.get("E", float, positive=True)
+    nu = t.get("nu", float, 0.3)
+    if not -1 < nu < 0.5:
+        t.fail("nu", f"must lie in (-1, 0.5), got {nu}")
+    G = t.get("G", float, E / (2 * (1 + nu)), positive=True)
+    rho = t.get("rho", float, 0.0)
+    t.done()
+    return E, G, rho, nu
+
+
+def _fix(t):
+    fix = t.get("fix", (str, list))
+    if isinstance(fix, str):
+        if fix not in FIX_WORDS:
+            t.fail("fix", f"{fix!r} is not allowed; allowed: {list(FIX_WORDS)} or a list of {list(DOF_NAMES)}")
+        return tuple(FIX_WORDS[fix])
+    bad = [d for d in fix if d not in DOF_NAMES]
+    if bad or not fix:
+        t.fail("fix", f"{bad or fix} not allowed; allowed: a list of {list(DOF_NAMES)}")
+    return tuple(fix)
+
+
+def parse_scene(data, file="<scene>", base=Path(".")):
+    """Scene from already-parsed TOML data (``file`` is used in error messages)."""
+    top = Table(data, "", file)
+    mat = _material(top.table("material", None))
+    beams = []
+    for t in top.tables("beams"):
+        name = t.get("name", str)
+        if ":" in name or name in [b.name for b in beams]:
+            t.fail("name", f"{name!r} must be unique and contain no ':'")
+        curve = _curve(t.table("curve"), base)
+        section = _section(t.table("section"), mat)
+        beams.append(Beam(
+            name, curve, section, t.get("elements", int, 8, positive=True),
+            t.get("degree", int, 2, choices=(1, 2, 3, 4)), t.get("orientation", "vec3", None),
+            t.get("twist_deg", float, 0.0),
+        ))
+        t.done()
+    if not beams:
+        top.fail("beams", "a scene needs at least one [[beams]] table")
+
+    supports = []
+    for t in top.tables("supports"):
+        supports.append(Support(t.get("at", str), _fix(t), t.get("displacement", "vec3", (0.0,) * 3),
+                                t.get("rotation", "vec3", (0.0,) * 3)))
+        t.done()
+    point_loads, distributed, gravity = [], [], (0.0, 0.0, 0.0)
+    for t in top.tables("loads"):
+        if t.has("gravity"):
+            gravity = t.get("gravity", "vec3")
+            t.done()
+            continue
+        kind = t.get("kind", str, "dead", choices=("dead", "follower"))
+        if t.has("at"):
+            point_loads.append(PointLoad(t.get("at", str), t.get("force", "vec3", (0.0,) * 3),
+                                         t.get("moment", "vec3", (0.0,) * 3), kind == "follower"))
+        else:
+            distributed.append(DistributedLoad(t.get("beam", str, None), t.get("force_per_length", "vec3", (0.0,) * 3),
+                                               t.get("moment_per_length", "vec3", (0.0,) * 3), kind == "follower"))
+        t.done(" (a point load has 'at'; a distributed one 'beam' or neither for all beams; or 'gravity')")
+    springs = []
+    for t in top.tables("springs"):
+        springs.append(Spring(t.get("at", str), t.get("stiffness", "vec3")))
+        t.done()
+
+    mt = top.table("model", {})
+    kin = Kinematics(
+        finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
+        shear=mt.get("shear", bool, True), stretch=mt.get("stretch", bool, True),
+    )
+    mt.done()
+    at = top.table("analysis", {})
+    analysis = at.get("type", str, "static", choices=ANALYSES)
+    steps = at.get("steps", int, 10, positive=True)
+    at.done()
+    if analysis == "linear_static":
+        kin = Kinematics(False, kin.shear, kin.stretch)
+
+    probes = {}
+    for t in top.tables("probes"):
+        probes[t.get("name", str)] = t.get("at", str)
+        t.done()
+    ot = top.table("output", {})
+    out_dir = ot.get("dir", str, "results")
+    ot.done()
+    solver = top.get("solver", dict, {})
+    top.done()
+
+    model = Model(tuple(beams), tuple(supports), tuple(point_loads), tuple(distributed),
+                  tuple(springs), gravity, kin)
+    _check_points(model, probes, file)
+    return Scene(file, model, analysis, steps, probes, out_dir, dict(solver))
+
+
+def _check_points(model, probes, file):
+    from ..analyses.spec import resolve_point
+
+    named = [(f"supports[{i}].at", s.at) for i, s in enumerate(model.supports)]
+    named += [(f"loads.at ({p.at})", p.at) for p in model.point_loads]
+    named += [(f"springs[{i}].at", s.at) for i, s in enumerate(model.springs)]
+    named += [(f"probes.{k}.at", v) for k, v in probes.items()]
+    for where, at in named:
+        try:
+            resolve_point(model, at)
+        except ValueError as e:
+            raise SceneError(f"{file}: {where}: {e}") from None
+    for d in model.distributed_loads:
+        if d.beam is not None and d.beam not in [b.name for b in model.beams]:
+            raise SceneError(f"{file}: loads.beam: {d.beam!r} is no beam; beams are {[b.name for b in model.beams]}")
+    if not model.supports:
+        raise SceneError(f"{file}: supports: none given; the structure is free (rigid-body motion)")
+
+
+def load_scene(path):
+    """Read and validate a scene file; raises :class:`SceneError` naming file and key."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"{path}: no such scene file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"{path}: not valid TOML: {e}") from None
+    return parse_scene(data, str(path), path.parent)
