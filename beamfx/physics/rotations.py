@@ -112,6 +112,6 @@ def unwrap_rotation_vector(q, previous):
     candidates = [
         sgn * (angle + 2 * np.pi * k) * axis
         for sgn in (1, -1)
-        for k in range(k0 - 2, k0 + 3)
+        for k in range(-k0 - 3, k0 + 4)
     ]
     return min(candidates, key=lambda c: np.linalg.norm(c - prev))

@@ -1,0 +1,62 @@
+"""The ``beamfx`` command: ``run``, ``check``, ``bench``. Each is one library call."""
+
+import argparse
+import sys
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="beamfx", description="Geometrically exact 3D beams on FEniCSx.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="solve a scene (the built-in 45-degree bend if none is given)")
+    p.add_argument("scene", nargs="?")
+    p.add_argument("--out", help="output folder (default: the scene's [output] dir)")
+    p = sub.add_parser("check", help="validate a scene file without solving")
+    p.add_argument("scene")
+    p = sub.add_parser("bench", help="run the benchmark cases and write a report")
+    p.add_argument("cases", nargs="*", help="case ids (default: all); see --list")
+    p.add_argument("--report", help="folder for bench.json and README.md")
+    p.add_argument("--list", action="store_true", help="list the case ids")
+    args = parser.parse_args(argv)
+
+    from .scene import SceneError
+
+    try:
+        if args.command == "run":
+            from .runner import run_scene
+
+            run_scene(args.scene, args.out)
+        elif args.command == "check":
+            from .runner import check_scene
+
+            scene = check_scene(args.scene)
+            print(f"{args.scene}: OK ({len(scene.model.beams)} beam(s), analysis {scene.analysis})")
+        elif args.command == "bench":
+            from .bench import all_cases
+            from .bench.run import run_bench
+
+            if args.list:
+                for cid, case in all_cases().items():
+                    print(f"{cid:28s} {case.title}")
+                return 0
+            unknown = [c for c in args.cases if c not in all_cases()]
+            if unknown:
+                raise SceneError(f"unknown bench case(s) {unknown}; allowed: {list(all_cases())}")
+            results = run_bench(args.cases or None, args.report)
+            failed = [r["id"] for r in results if not r["passed"]]
+            print(f"{len(results) - len(failed)}/{len(results)} cases within tolerance" +
+                  (f"; outside: {failed}" if failed else ""))
+    except (SceneError, ValueError, OSError) as e:
+        print(f"beamfx: error: {e}", file=sys.stderr)
+        return 2
+    except Exception as e:  # a failed solve: report it plainly, no traceback soup
+        from .solvers import SolveFailed
+
+        if isinstance(e, SolveFailed):
+            print(f"beamfx: solve failed: {e}", file=sys.stderr)
+            return 3
+        raise
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,25 @@
+import os
+
+os.environ.setdefault("SETUPTOOLS_USE_DISTUTILS", "stdlib")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+
+def nodal(model, sub):
+    """Coordinates and values (n, comps) of the displacement (0) or rotation (1) nodes."""
+    V, dofs = model.W.sub(sub).collapse()
+    X = V.tabulate_dof_coordinates()
+    return X, model.w.x.array[dofs].reshape(len(X), -1), dofs
+
+
+def value_at(model, sub, xyz):
+    """Nodal value nearest to ``xyz`` (local to this rank)."""
+    X, vals, _ = nodal(model, sub)
+    i = np.argmin(np.linalg.norm(X - np.asarray(xyz), axis=1))
+    return X[i], vals[i]
+
+
+@pytest.fixture
+def tmp_out(tmp_path):
+    return tmp_path / "out"
