@@ -24,14 +24,12 @@ def run_scene(path=None, out_dir=None, log=None):
     from .analyses.checks import check_supported
     from .analyses.model import BeamModel
     from .analyses.static import solve_static
-    from .io import log as _log
-    from .io.fields import nodal_fields
-    from .io.paraview import PvdSeries, XdmfSeries
-    from .io.probes import evaluate_points, track_rotations
-    from .io.results import check_writable, write_json_atomic
+    from .io import (PvdSeries, XdmfSeries, check_writable, evaluate_points, nodal_fields,
+                     track_rotations, write_json_atomic, write_vtu)
+    from .io import log as default_log
     from .scene import load_scene
 
-    log = log or _log.log
+    log = log or default_log
     comm = MPI.COMM_WORLD
     t_start = time.perf_counter()
     path = Path(path) if path else default_scene_path()
@@ -52,7 +50,9 @@ def run_scene(path=None, out_dir=None, log=None):
 
     def on_step(step):
         fields = nodal_fields(model)
-        pvd.add(step.load_factor, fields, out / f"deformed_{step.step:04d}.vtu")
+        vtu = out / f"deformed_{step.step:04d}.vtu"
+        write_vtu(vtu, fields)
+        pvd.add(step.load_factor, vtu)
         xdmf.add(step.load_factor, fields)
         values = evaluate_points(model, list(scene.probes.values()))
         probes_path[step.load_factor] = track_rotations(probes_path.get("_last"), values)

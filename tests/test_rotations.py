@@ -72,3 +72,13 @@ def test_ufl_hat_axial_and_quaternion_rates_agree_with_numpy():
     assert np.allclose(num(spatial_rate(Q, dQ), (3,)), [W_spatial[2, 1], W_spatial[0, 2], W_spatial[1, 0]], atol=1e-7)
     v = np.array([0.2, -1.0, 3.0])
     assert np.allclose(num(axial(hat(ufl.as_vector(v.tolist()))), (3,)), v)
+
+
+def test_unwrap_with_uneven_steps_past_pi():
+    """A step from 2.8 to 3.2 rad must continue forward, not jump back (regression)."""
+    v = unwrap_rotation_vector(np_quaternion((0, 0, 1), 3.2), (0, 0, 2.8))
+    assert np.allclose(v, (0, 0, 3.2))
+    previous = np.zeros(3)
+    for angle in np.cumsum(np.full(37, 0.37)):
+        previous = unwrap_rotation_vector(np_quaternion((1, 2, 2), angle), previous)
+    assert np.allclose(previous, 0.37 * 37 * np.array([1, 2, 2]) / 3)

@@ -78,11 +78,9 @@ def np_quaternion(axis, angle):
 
 
 def axis_angle(q):
-    """Axis and angle in [0, 2π] of a quaternion (the angle the quaternion itself encodes).
+    """Axis and angle in [0, 2π] of the rotation of a quaternion of any norm.
 
-    Unlike a rotation matrix, a continuous quaternion field remembers full turns modulo 4π:
-    ``q`` and ``-q`` are the same rotation but angles φ and 4π - φ... here reported in [0, 2π]
-    with the axis flipped as needed, see :func:`unwrap_angle` to follow a load path.
+    Use :func:`unwrap_rotation_vector` to follow angles beyond 2π along a load path.
     """
     q = np.asarray(q, dtype=float)
     q = q / np.linalg.norm(q)
@@ -101,17 +99,14 @@ def principal_rotation_vector(q):
 
 
 def unwrap_rotation_vector(q, previous):
-    """Rotation vector of ``q`` closest to ``previous`` among all 2π-equivalent ones.
+    """Rotation vector of ``q`` closest to ``previous`` among all equivalent ones.
 
-    Used to follow a rotation past π, 2π, 4π along a load or time path: the candidate
-    ``(φ + 2πk) n`` (and with -n) nearest to the previous value is kept.
+    The rotation vectors of the rotation (n, φ) are (φ + 2πk) n for every integer k (negative
+    k gives the turns the other way about n). Keeping the one nearest to the previous value
+    follows a rotation past π, 2π, 4π along a load or time path.
     """
     axis, angle = axis_angle(q)
     prev = np.asarray(previous, dtype=float)
-    k0 = int(np.round(np.linalg.norm(prev) / (2 * np.pi)))
-    candidates = [
-        sgn * (angle + 2 * np.pi * k) * axis
-        for sgn in (1, -1)
-        for k in range(-k0 - 3, k0 + 4)
-    ]
+    k0 = int(np.ceil(np.linalg.norm(prev) / (2 * np.pi)))
+    candidates = [(angle + 2 * np.pi * k) * axis for k in range(-k0 - 2, k0 + 3)]
     return min(candidates, key=lambda c: np.linalg.norm(c - prev))

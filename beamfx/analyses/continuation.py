@@ -1,0 +1,188 @@
+"""Equilibrium paths past limit points: arc-length continuation of a :class:`BeamModel`.
+
+The path is parametrised by the load factor λ of ``model.F = F_int(w) - λ F_ext(w)`` and the
+displacement of one named point; the arc length measures the displacement dofs only (the
+``W.sub(0)`` dofs), so that quaternion components do not weigh in (Crisfield 1981, §3).
+"""
+
+import time
+from dataclasses import replace
+from typing import NamedTuple
+
+import numpy as np
+from mpi4py import MPI
+
+from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
+from ..solvers.forms import compile_seconds
+from .spec import DOF_NAMES
+
+
+class PathPoint(NamedTuple):
+    load_factor: float
+    displacement: np.ndarray  # (3,) at the control point, global axes
+    iterations: int  # corrector iterations of the step that reached it (0 at the start)
+    arc_length: float  # s, the path length from the start (measured on the displacement dofs)
+
+
+class LimitPoint(NamedTuple):
+    kind: str  # "maximum" or "minimum" of the load factor along the path
+    load_factor: float
+    displacement: np.ndarray  # (3,) at the control point
+    arc_length: float
+
+
+class ContinuationResult(NamedTuple):
+    path: tuple  # PathPoint, the first one the starting state
+    control_point: str
+    steps: tuple  # ArcLengthStep records of the solver
+    reason: str  # why the trace ended: "target", "stop" (displacement limit, stop), "max_steps"
+    seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, total
+
+    @property
+    def load_factors(self):
+        return np.array([p.load_factor for p in self.path])
+
+    @property
+    def displacements(self):
+        return np.array([p.displacement for p in self.path]).reshape(-1, 3)
+
+
+def point_displacement_dofs(model, at):
+    """Owned local dofs of u_x, u_y, u_z at the named point ``at`` (empty where not owned)."""
+    from dolfinx import fem
+
+    if at not in model.mesh.points:
+        raise ValueError(f"{at!r} is not a named point of the model; named points are "
+                         f"{sorted(model.mesh.points)} (supports, loads and springs)")
+    verts = model.mesh.point_tags.find(model.mesh.points[at][0])
+    owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
+    out = []
+    for i in range(3):
+        d = fem.locate_dofs_topological(model.W.sub(0).sub(i), 0, verts)
+        out.append(d[d < owned][:1])
+    return out
+
+
+def point_displacement(model, dofs):
+    """u at a point from :func:`point_displacement_dofs` (collective)."""
+    local = np.array([model.w.x.array[d].sum() for d in dofs])
+    count = np.array([len(d) for d in dofs], float)
+    total = model.comm.allreduce(local, op=MPI.SUM)
+    n = model.comm.allreduce(count, op=MPI.SUM)
+    return total / np.maximum(n, 1)
+
+
+def _check_model(model):
+    for sup in model.spec.supports:
+        if np.any(sup.displacement) or np.any(sup.rotation):
+            raise ValueError(f"support at {sup.at!r} prescribes a displacement or rotation: "
+                             "arc-length continuation scales loads only (use solve_static)")
+
+
+def trace_path(model, control_point=None, max_steps=100, target_load_factor=None, arc_length=None,
+               first_load_increment=0.05, displacement_limit=None, stop=None, settings=None,
+               options=None, prefix="beamfx_arclength_", on_step=None, log=None):
+    """Follow the equilibrium path of ``model`` from its current state by arc length.
+
+    Crisfield's cylindrical arc length on the displacement dofs (ψ = 0 by default) with a
+    bordered Newton corrector; see :mod:`beamfx.solvers.arclength` for the equations.
+
+    Args:
+        model: :class:`~beamfx.analyses.model.BeamModel` in a converged state (e.g. just reset).
+        control_point: named point whose displacement is recorded; default the first point
+            load's point.
+        max_steps: accepted arc-length steps before stopping.
+        target_load_factor: stop on reaching this load factor (landing exactly on it).
+        arc_length: first arc length (displacement units); None: that of a first load
+            increment ``first_load_increment`` on the linear tangent.
+        first_load_increment: see ``arc_length``.
+        displacement_limit: ``(component, value)`` with component in "ux", "uy", "uz": stop
+            once that displacement of the control point reaches ``|value|`` in magnitude.
+        stop: ``stop(path) -> bool`` called with the list of :class:`PathPoint` after each
+            step; True ends the trace (e.g. once the load has dropped past a limit point).
+        settings: :class:`~beamfx.solvers.arclength.ArcLengthSettings` (follower loads are
+            detected from the model).
+        options, prefix: PETSc options of the linear solver and their mandatory prefix.
+        on_step: called with each new :class:`PathPoint`.
+        log: callable for one-line progress messages.
+
+    Returns:
+        :class:`ContinuationResult`.
+
+    Raises:
+        SolveFailed: when the arc length has to shrink below its minimum.
+        ValueError: for prescribed support motions or unknown names.
+    """
+    t0 = time.perf_counter()
+    _check_model(model)
+    spec = model.spec
+    if control_point is None:
+        if not spec.point_loads:
+            raise ValueError("no point load: name a control_point")
+        control_point = spec.point_loads[0].at
+    dofs = point_displacement_dofs(model, control_point)
+    if displacement_limit is not None:
+        comp, limit = displacement_limit
+        if comp not in DOF_NAMES[:3]:
+            raise ValueError(f"displacement_limit component must be one of {DOF_NAMES[:3]}, got {comp!r}")
+        comp = DOF_NAMES.index(comp)
+
+    follower = any(ld.follower for ld in (*spec.point_loads, *spec.distributed_loads))
+    base = settings or ArcLengthSettings()
+    settings = replace(base, follower=base.follower or follower)
+    c0 = compile_seconds[0]
+    _, u_dofs = model.W.sub(0).collapse()
+    solver = ArcLengthSolver(model.F, model.J, model.w, model.load_factor, model.bcs, prefix,
+                             options, settings, norm_dofs=np.asarray(u_dofs))
+    compile_time = compile_seconds[0] - c0
+
+    path = [PathPoint(float(model.load_factor.value), point_displacement(model, dofs), 0, 0.0)]
+
+    def record(step):
+        s = path[-1].arc_length + step.arc_length
+        path.append(PathPoint(step.load_factor, point_displacement(model, dofs), step.iterations, s))
+        if on_step:
+            on_step(path[-1])
+
+    def stop_here(step):
+        if displacement_limit is not None and abs(path[-1].displacement[comp]) >= abs(limit):
+            return True
+        return bool(stop is not None and stop(path))
+
+    try:
+        result = solver.trace(arc_length, first_load_increment, max_steps, target_load_factor,
+                              stop_here, record, log)
+    finally:
+        solver.destroy()
+    model.set_load_factor(float(model.load_factor.value))  # the support values follow λ
+    seconds = {"compile": compile_time, **result.seconds, "total": time.perf_counter() - t0}
+    return ContinuationResult(tuple(path), control_point, result.steps, result.reason, seconds)
+
+
+def limit_points(path):
+    """Local extrema of the load factor along a path, located by a parabola in s.
+
+    The parabola through the three path points around a discrete extremum, λ(s) and u(s)
+    quadratic in the arc length s, places the limit point with an error O(Δs³).
+
+    Args:
+        path: sequence of :class:`PathPoint` (``ContinuationResult.path``).
+
+    Returns:
+        list of :class:`LimitPoint` in path order.
+    """
+    lam = np.array([p.load_factor for p in path])
+    s = np.array([p.arc_length for p in path])
+    u = np.array([p.displacement for p in path]).reshape(-1, 3)
+    out = []
+    for i in range(1, len(path) - 1):
+        rise, fall = lam[i] - lam[i - 1], lam[i + 1] - lam[i]
+        if rise * fall >= 0:
+            continue
+        x = s[i - 1:i + 2]
+        c = np.polyfit(x - x[1], lam[i - 1:i + 2], 2)
+        ds = -c[1] / (2 * c[0])
+        du = [np.polyval(np.polyfit(x - x[1], u[i - 1:i + 2, k], 2), ds) for k in range(3)]
+        out.append(LimitPoint("maximum" if rise > 0 else "minimum", float(np.polyval(c, ds)),
+                              np.array(du), float(x[1] + ds)))
+    return out

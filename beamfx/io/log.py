@@ -1,0 +1,62 @@
+"""Rank-0 logging and a one-line progress display."""
+
+import sys
+
+from mpi4py import MPI
+
+
+def log(msg, comm=MPI.COMM_WORLD, stream=None):
+    """Print ``msg`` on rank 0 only, flushed (other ranks' output is block-buffered)."""
+    if comm.rank == 0:
+        print(msg, file=stream or sys.stdout, flush=True)
+
+
+class Progress:
+    """Progress of a loop: one self-overwriting line on a terminal, plain lines otherwise.
+
+    Silent on ranks other than 0. Use as a context manager, or call :meth:`close`.
+
+    Args:
+        total: number of units of work, or None if unknown.
+        label: text before the counter.
+        stream: output stream (standard output by default).
+        comm: the communicator whose rank 0 prints.
+    """
+
+    def __init__(self, total=None, label="", stream=None, comm=MPI.COMM_WORLD):
+        self.total, self.label = total, label
+        self.stream = stream or sys.stdout
+        self.active = comm.rank == 0
+        self.tty = self.active and hasattr(self.stream, "isatty") and self.stream.isatty()
+        self._width = 0
+
+    def update(self, done, text=""):
+        """Report ``done`` units finished, with an optional note (e.g. "λ = 0.5, 4 its")."""
+        if not self.active:
+            return
+        count = f"{done}/{self.total}" if self.total else f"{done}"
+        line = " ".join(p for p in (self.label, count, text) if p)
+        if self.tty:
+            pad = max(0, self._width - len(line))
+            self.stream.write("\r" + line + " " * pad)
+            self._width = len(line)
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def close(self, text=""):
+        """End the progress line (a newline on a terminal), with an optional final note."""
+        if not self.active:
+            return
+        if self.tty and self._width:
+            self.stream.write("\n")
+            self._width = 0
+        if text:
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

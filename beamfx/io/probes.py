@@ -1,0 +1,136 @@
+"""Values at named points (mesh vertices): position, rotation, section frame, force, moment.
+
+Each rank evaluates the named points whose vertex it owns, on one adjacent local cell, with
+the shared section expression at both cell ends (ξ = 0 and 1); the answers are allgathered so
+that every rank returns the same dictionary.
+"""
+
+import numpy as np
+
+from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_rotation_vector
+from ._sections import evaluate
+
+CELL_ENDS = np.array([[0.0], [1.0]])
+
+
+def _locate(model, name):
+    """(cell, end) of the named point's vertex if this rank owns it, else None.
+
+    Of the cells at the vertex, the one first in the input order is used (for a point inside
+    a beam: the cell before it), so that serial and parallel runs report the same cell.
+    """
+    import dolfinx.cpp.mesh
+
+    m = model.mesh.mesh
+    tag = model.mesh.points[name][0]
+    vertices = model.mesh.point_tags.find(tag)
+    owned = vertices[vertices < m.topology.index_map(0).size_local]
+    if len(owned) == 0:
+        return None
+    v = int(owned[0])
+    cells = m.topology.connectivity(0, 1).links(v)
+    original = np.asarray(m.topology.original_cell_index)
+    c = int(cells[np.argmin(original[cells])])
+    node = dolfinx.cpp.mesh.entities_to_geometry(m._mesh, 0, np.array([v], np.int32), False)[0, 0]
+    ends = m.geometry.dofmap.links(c)[:2]
+    if node not in ends:
+        raise RuntimeError(f"vertex of point {name!r} is not an end of its cell {c}")
+    return c, int(np.flatnonzero(ends == node)[0])
+
+
+def _point_values(finite, v):
+    """The documented dictionary of one point from the evaluated quantities ``v``."""
+    X, u, rot = v["X"], v["u"], v["rot"]
+    out = {"position": (X + u).tolist(), "displacement": u.tolist()}
+    if finite:
+        axis, angle = axis_angle(rot)
+        out["quaternion"] = (rot / np.linalg.norm(rot)).tolist()
+        out["rotation_vector"] = principal_rotation_vector(rot).tolist()
+    else:
+        angle = float(np.linalg.norm(rot))
+        axis = rot / angle if angle > 0 else np.array([1.0, 0.0, 0.0])
+        out["rotation_vector"] = rot.tolist()
+    out["axis"], out["angle"] = np.asarray(axis).tolist(), float(angle)
+    out["section_axes"] = v["axes"].tolist()
+    out["section_force"], out["section_moment"] = v["N"].tolist(), v["M"].tolist()
+    return out
+
+
+def evaluate_points(model, names=None, recover=True):
+    """Evaluate the solution at named points. Collective.
+
+    Args:
+        model: :class:`~beamfx.analyses.model.BeamModel` (its current ``w``).
+        names: names of ``model.mesh.points`` (all of them if None).
+        recover: N and M extrapolated from the cell's Gauss points (default) rather than
+            taken pointwise at the vertex, see :func:`beamfx.io._sections.evaluate`.
+
+    Returns:
+        ``{name: values}`` on every rank, where ``values`` holds plain lists and floats:
+        ``position`` x = X + u and ``displacement`` u (global axes); ``rotation_vector``, the
+        principal one (|θ| ≤ π) for finite rotations, θ itself for linear kinematics (global
+        axes); ``axis`` and ``angle`` (angle in [0, 2π], the angle the quaternion encodes);
+        ``quaternion`` (unit, finite kinematics only); ``section_axes``, the 3×3 matrix R·Λ0
+        whose columns are the current section axes (t, e2, e3) in global axes;
+        ``section_force`` N = C_N Γ and ``section_moment`` M = C_M K (section axes, Simo 1985
+        eq. 2.12) from one adjacent cell, the first in input order (N and M jump at a point
+        load; only that side is reported).
+
+    Raises:
+        ValueError: if a name is not a named point of the model.
+    """
+    comm = model.comm
+    names = list(model.mesh.points) if names is None else list(names)
+    unknown = [n for n in names if n not in model.mesh.points]
+    if unknown:
+        raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
+    model.mesh.mesh.topology.create_connectivity(0, 1)
+
+    found = [(n, _locate(model, n)) for n in names]
+    found = [(n, loc) for n, loc in found if loc is not None]
+    values = evaluate(model, CELL_ENDS, [c for _, (c, _) in found], recover)
+    local = {}
+    for i, (n, (_, end)) in enumerate(found):
+        local[n] = _point_values(model.kin.finite, {k: a[i, end] for k, a in values.items()})
+
+    result = {}
+    for part in comm.allgather(local):
+        for n, v in part.items():
+            result.setdefault(n, v)
+    missing = [n for n in names if n not in result]
+    if missing:  # every rank sees the same gathered result, so all raise together
+        raise RuntimeError(f"named points {missing} were found on no rank")
+    return {n: result[n] for n in names}
+
+
+def track_rotations(previous, current):
+    """Add ``rotation_vector_unwrapped`` and ``angle_unwrapped`` to ``current``, in place.
+
+    Follows each point's rotation along a load or time path: of the rotation vectors
+    equivalent to the current quaternion ((φ + 2πk) n, k integer), the one closest to the
+    previous unwrapped value is kept (:func:`~beamfx.physics.rotations.unwrap_rotation_vector`), so a roll-up to two turns reports an
+    angle of 4π. The path must be sampled finely enough that a point turns by less than π
+    between calls.
+
+    Args:
+        previous: an earlier result of :func:`evaluate_points` (already tracked), or None or
+            ``{}`` for the first step (the path then starts from the undeformed state, θ = 0).
+        current: the new result of :func:`evaluate_points`.
+
+    Returns:
+        ``current``.
+    """
+    previous = previous or {}
+    for name, v in current.items():
+        before = previous.get(name, {})
+        prev = before.get("rotation_vector_unwrapped", before.get("rotation_vector", np.zeros(3)))
+        if "quaternion" in v:
+            theta = unwrap_rotation_vector(v["quaternion"], prev)
+        else:  # linear kinematics: θ is already the field
+            theta = np.asarray(v["rotation_vector"], float)
+        v["rotation_vector_unwrapped"] = np.asarray(theta).tolist()
+        v["angle_unwrapped"] = float(np.linalg.norm(theta))
+    return current
+
+
+__all__ = ["evaluate_points", "track_rotations"]

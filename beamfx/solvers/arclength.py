@@ -1,0 +1,459 @@
+r"""Arc-length continuation of :math:`R(w, λ) = F(w, λ) = F_{int}(w) - λ f(w) = 0`.
+
+Crisfield's (1981) cylindrical/spherical arc length with a bordered Newton solve, or the
+Riks (1979) normal-plane variant. Knows nothing of beams: it needs the compiled residual form
+``F`` (load factor a ``fem.Constant``), its Jacobian ``J``, the unknowns ``w`` and the Dirichlet
+conditions, whose values stay fixed along the path (the increments are homogeneous there).
+
+Each step :math:`n \to n+1` with arc length :math:`Δl` solves :math:`R(w_n + Δw, λ_n + Δλ) = 0`
+together with the constraint
+
+.. math::  a(Δw, Δλ) = Δw^T S Δw + ψ^2 Δλ^2 f^T f - Δl^2 = 0,
+
+where ``S`` selects the dofs that measure the path (e.g. displacements, so that rotation or
+quaternion components do not dominate) and ψ weighs the load (ψ = 0: cylindrical, ψ = 1:
+spherical). Each iteration factorises the tangent :math:`K = ∂R/∂w` once and solves twice,
+
+.. math::  K δw_R = -R, \qquad K δw_f = f, \qquad δw = δw_R + δλ\, δw_f,
+
+and δλ is the root of the quadratic :math:`a_1 δλ^2 + a_2 δλ + a_3 = 0` (Crisfield 1981,
+eqs. 16–19) with :math:`u = Δw + δw_R`:
+
+.. math::
+    a_1 = δw_f^T S δw_f + ψ^2 f^T f, \quad
+    a_2 = 2 δw_f^T S u + 2 ψ^2 Δλ f^T f, \quad
+    a_3 = u^T S u + ψ^2 Δλ^2 f^T f - Δl^2,
+
+taking the root whose new increment makes the smaller angle with the previous one. The Riks
+variant keeps the iterates on the plane normal to the predictor :math:`(Δw_0, Δλ_0)`:
+:math:`δλ = -Δw_0^T S δw_R / (Δw_0^T S δw_f + ψ^2 Δλ_0 f^T f)`.
+
+The predictor is :math:`Δw_0 = Δλ_0 δw_f` with :math:`Δλ_0 = ± Δl / \sqrt{δw_f^T S δw_f + ψ^2 f^T
+f}`, its sign that of :math:`Δw_{prev}^T S δw_f + ψ^2 Δλ_{prev} f^T f` (keep moving forward
+through limit points and snap-backs). The next arc length is :math:`Δl (I_d / I)^{1/2}`
+(Crisfield 1981, eq. 25) for ``I`` iterations and a desired :math:`I_d`, bounded; a failed step is
+retried with half the arc length.
+
+References:
+    M. A. Crisfield, "A fast incremental/iterative solution procedure that handles
+    snap-through", Computers & Structures 13 (1981) 55–62.
+    E. Riks, "An incremental approach to the solution of snapping and buckling problems",
+    Int. J. Solids Struct. 15 (1979) 529–551.
+"""
+
+import math
+import time
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from .forms import compile_form
+from .options import petsc_options
+from .snes import SolveFailed
+
+#: the bordered system is solved twice per factorisation: a direct solver is the natural fit
+DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+
+
+@dataclass(frozen=True)
+class ArcLengthSettings:
+    """Controls of :class:`ArcLengthSolver`.
+
+    Attributes:
+        method: "crisfield" (quadratic constraint) or "riks" (normal plane to the predictor).
+        psi: weight ψ of the load term in the constraint (0: cylindrical, 1: spherical).
+        follower: the load vector f depends on w (follower loads): re-assemble it every
+            iteration as f = F(w, 0) - F(w, 1); otherwise it is assembled once.
+        rtol: converged when ‖R‖ ≤ atol + rtol·‖f‖·max(1, |λ|) (‖f‖: load vector at the
+            start) ...
+        atol: absolute residual tolerance, in the units of the residual.
+        stol: ... or when the last correction is small, ‖δw‖ ≤ stol·‖Δw‖ (Newton converges
+            quadratically, so the error left is O(‖δw‖²)): stiff axial, shear and penalty
+            terms put a round-off floor under ‖R‖ (SNES's CONVERGED_SNORM_RELATIVE).
+        max_iterations: corrector iterations per step before the step counts as failed.
+        divergence: a step fails when ‖R‖ exceeds this multiple of its first residual.
+        desired_iterations: I_d of the step-size rule Δl_new = Δl (I_d / I)^½.
+        max_growth: bound on Δl_new / Δl after a converged step.
+        min_arc_length, max_arc_length: bounds on Δl, as multiples of the first arc length.
+    """
+
+    method: str = "crisfield"
+    psi: float = 0.0
+    follower: bool = False
+    rtol: float = 1e-9
+    atol: float = 0.0
+    stol: float = 1e-8
+    max_iterations: int = 12
+    divergence: float = 1e6
+    desired_iterations: int = 5
+    max_growth: float = 2.0
+    min_arc_length: float = 1e-4
+    max_arc_length: float = 10.0
+
+
+class ArcLengthStep(NamedTuple):
+    step: int
+    load_factor: float
+    arc_length: float  # length of the step, (Δw^T S Δw + ψ² Δλ² f^T f)^½ (= Δl for Crisfield)
+    iterations: int  # corrector iterations (one factorisation each)
+    residuals: tuple  # ‖R‖ before each corrector iteration and at convergence
+    cutbacks: int  # failed attempts before this step converged
+
+
+class ArcLengthResult(NamedTuple):
+    steps: tuple  # accepted ArcLengthStep records
+    reason: str  # "target", "stop", "max_steps"
+    seconds: dict  # wall time split: assemble_F, assemble_J, solve, total
+
+
+class _StepFailed(Exception):
+    pass
+
+
+class ArcLengthSolver:
+    """Arc-length continuation over a residual form linear in the load factor.
+
+    Args:
+        F: UFL or compiled residual form F(w, λ) = F_int(w) - λ f(w).
+        J: UFL or compiled Jacobian ∂F/∂w.
+        w: dolfinx Function of the unknowns; holds the current point of the path.
+        load_factor: the ``fem.Constant`` λ in ``F``; holds the current load factor.
+        bcs: Dirichlet conditions; their values must not change along the path.
+        prefix: PETSc options prefix of the linear solver (mandatory, e.g. "beamfx_arc_").
+        options: PETSc options without the prefix, merged over :data:`DEFAULT_OPTIONS`.
+        settings: :class:`ArcLengthSettings`.
+        norm_dofs: local indices (of ``w.x.array``) of the dofs measured by the arc length
+            (the matrix S); None measures all dofs.
+    """
+
+    def __init__(self, F, J, w, load_factor, bcs, prefix, options=None, settings=None,
+                 norm_dofs=None):
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        self.settings = settings or ArcLengthSettings()
+        if self.settings.method not in ("crisfield", "riks"):
+            raise ValueError(f"method must be 'crisfield' or 'riks', got {self.settings.method!r}")
+        self.w, self.lam, self.bcs = w, load_factor, bcs
+        self.F = F if hasattr(F, "ufcx_form") else compile_form(F)
+        self.J = J if hasattr(J, "ufcx_form") else compile_form(J)
+        self.comm = w.function_space.mesh.comm
+        self.A = fp.create_matrix(self.J)
+        self.R, self.f = fp.create_vector(self.F), fp.create_vector(self.F)
+        self.dw_R, self.dw_f = self.R.duplicate(), self.R.duplicate()
+        self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0}
+
+        n_owned = w.function_space.dofmap.index_map.size_local * w.function_space.dofmap.index_map_bs
+        if norm_dofs is None:
+            self.norm_dofs = slice(None)
+        else:
+            d = np.asarray(norm_dofs)
+            self.norm_dofs = d[d < n_owned]
+
+        ksp = PETSc.KSP().create(self.comm)
+        ksp.setOptionsPrefix(prefix)
+        self.options = {**DEFAULT_OPTIONS, **(options or {})}
+        with petsc_options(prefix, self.options):
+            ksp.setFromOptions()
+        self.ksp = ksp
+
+    # --- assembly and linear algebra -------------------------------------------------------
+
+    def _residual(self, lam):
+        """R(w, λ) with zero rows on the constrained dofs (w satisfies the bcs)."""
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        t = time.perf_counter()
+        self.lam.value = lam
+        x, b = self.w.vector, self.R
+        with b.localForm() as local:
+            local.set(0.0)
+        fp.assemble_vector(b, self.F)
+        fp.apply_lifting(b, [self.J], bcs=[self.bcs], x0=[x], scale=-1.0)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        fp.set_bc(b, self.bcs, x, -1.0)
+        self.seconds["assemble_F"] += time.perf_counter() - t
+        return b.norm()
+
+    def _load(self):
+        """f = F(w, 0) - F(w, 1) = -∂F/∂λ at the current w, zero on constrained dofs."""
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        t = time.perf_counter()
+        lam = float(self.lam.value)
+        tmp = self.f.duplicate()
+        for vec, value in ((self.f, 0.0), (tmp, 1.0)):
+            self.lam.value = value
+            with vec.localForm() as local:
+                local.set(0.0)
+            fp.assemble_vector(vec, self.F)
+            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.f.axpy(-1.0, tmp)
+        tmp.destroy()
+        fp.set_bc(self.f, self.bcs, scale=0.0)
+        self.lam.value = lam
+        self.ff = self.f.dot(self.f)
+        self.seconds["assemble_F"] += time.perf_counter() - t
+
+    def _factor(self, lam):
+        """Assemble K = ∂R/∂w at (w, λ) and factorise it."""
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        t = time.perf_counter()
+        self.lam.value = lam
+        self.A.zeroEntries()
+        fp.assemble_matrix(self.A, self.J, bcs=self.bcs)
+        self.A.assemble()
+        self.seconds["assemble_J"] += time.perf_counter() - t
+        t = time.perf_counter()
+        try:
+            self.ksp.setOperators(self.A)
+            self.ksp.setUp()
+        except PETSc.Error as e:
+            raise _StepFailed(f"factorisation failed (PETSc error {e.ierr})") from None
+        finally:
+            self.seconds["solve"] += time.perf_counter() - t
+
+    def _solve(self, rhs, out, scale=1.0):
+        """out = scale · K⁻¹ rhs with the current factorisation."""
+        t = time.perf_counter()
+        self.ksp.solve(rhs, out)
+        if scale != 1.0:
+            out.scale(scale)
+        self.seconds["solve"] += time.perf_counter() - t
+        if self.ksp.getConvergedReason() < 0 or not np.isfinite(out.norm()):
+            raise _StepFailed(f"linear solve failed (KSP reason {self.ksp.getConvergedReason()})")
+
+    def _dot(self, a, b):
+        """a^T S b over the owned dofs of all ranks."""
+        from mpi4py import MPI
+
+        local = np.dot(a.getArray(readonly=True)[self.norm_dofs], b.getArray(readonly=True)[self.norm_dofs])
+        return self.comm.allreduce(float(local), op=MPI.SUM)
+
+    def _add(self, vec, alpha=1.0):
+        """w += alpha · vec (owned dofs), then refresh the ghosts."""
+        self.w.vector.axpy(alpha, vec)
+        self.w.x.scatter_forward()
+
+    # --- one step --------------------------------------------------------------------------
+
+    def _tangent(self, lam):
+        """δw_f = K⁻¹ f at the current point."""
+        self._factor(lam)
+        if self.settings.follower:
+            self._load()
+        self._solve(self.f, self.dw_f)
+        return self.dw_f.copy()
+
+    def _step(self, lam_n, dl, direction, land_at=None):
+        """Corrector iterations of one step from the current (converged) state (w_n, λ_n).
+
+        Args:
+            direction: (Δw_prev, Δλ_prev) of the previous step, or the sign of the first one.
+            land_at: solve at this fixed load factor instead (δλ = 0), from the predictor
+                ``direction = (Δw, Δλ)`` scaled onto it.
+
+        Returns:
+            (Δw, Δλ, iterations, residuals); w and λ hold the new point.
+        """
+        s, ff = self.settings, self.ff
+        if land_at is None:
+            t = self._tangent(lam_n)
+            a = math.sqrt(self._dot(t, t) + s.psi**2 * ff)
+            if a == 0:
+                raise _StepFailed("the load moves no measured dof (δw_f^T S δw_f = 0, ψ = 0)")
+            if isinstance(direction, tuple):
+                sign = math.copysign(1.0, self._dot(direction[0], t) + s.psi**2 * direction[1] * ff)
+            else:
+                sign = direction
+            dlam = sign * dl / a
+            dw = t
+            dw.scale(dlam)
+        else:
+            dw, dlam = direction[0].copy(), direction[1]
+            dw.scale((land_at - lam_n) / dlam)
+            dlam = land_at - lam_n
+        dw0, dlam0 = dw.copy(), dlam
+        self._add(dw)
+
+        residuals, small = [], False
+        for it in range(s.max_iterations + 1):
+            residuals.append(self._residual(lam_n + dlam))
+            tol = s.atol + s.rtol * self.f_norm * max(1.0, abs(lam_n + dlam))
+            if residuals[-1] <= tol or small:
+                return dw, dlam, it, tuple(residuals)
+            if not np.isfinite(residuals[-1]) or residuals[-1] > s.divergence * max(residuals[0], tol):
+                raise _StepFailed("diverged", tuple(residuals))
+            if it == s.max_iterations:
+                break
+            try:
+                self._factor(lam_n + dlam)
+                self._solve(self.R, self.dw_R, scale=-1.0)
+                if land_at is not None:
+                    ddlam = 0.0
+                else:
+                    if s.follower:
+                        self._load()
+                    self._solve(self.f, self.dw_f)
+                    ddlam = self._constraint(dw, dlam, dw0, dlam0, dl)
+            except _StepFailed as e:
+                raise _StepFailed(e.args[0], tuple(residuals)) from None
+            self.dw_R.axpy(ddlam, self.dw_f)
+            dw.axpy(1.0, self.dw_R)
+            small = self.dw_R.norm() <= s.stol * dw.norm()
+            dlam += ddlam
+            self._add(self.dw_R)
+        raise _StepFailed(f"no convergence in {s.max_iterations} iterations", tuple(residuals))
+
+    def _constraint(self, dw, dlam, dw0, dlam0, dl):
+        """δλ of the bordered system (Crisfield's quadratic or Riks' normal plane)."""
+        s, ff, dR, df = self.settings, self.ff, self.dw_R, self.dw_f
+        if s.method == "riks":
+            den = self._dot(dw0, df) + s.psi**2 * dlam0 * ff
+            return -self._dot(dw0, dR) / den
+        u = dw.copy()
+        u.axpy(1.0, dR)
+        a1 = self._dot(df, df) + s.psi**2 * ff
+        a2 = 2 * self._dot(df, u) + 2 * s.psi**2 * dlam * ff
+        a3 = self._dot(u, u) + s.psi**2 * dlam**2 * ff - dl**2
+        disc = a2**2 - 4 * a1 * a3
+        if a1 <= 0 or disc < 0:
+            u.destroy()
+            raise _StepFailed("the constraint has no real root (arc length too large)")
+        q = -0.5 * (a2 + math.copysign(math.sqrt(disc), a2))  # stable quadratic roots
+        roots = (q / a1, a3 / q) if q != 0 else (0.0, 0.0)
+        # smallest angle with the previous increment: largest (u + δλ δw_f)^T S Δw
+        u_dw, df_dw = self._dot(u, dw), self._dot(df, dw)
+        cos = [u_dw + r * df_dw + s.psi**2 * dlam * (dlam + r) * ff for r in roots]
+        u.destroy()
+        return roots[int(np.argmax(cos))]
+
+    # --- the path --------------------------------------------------------------------------
+
+    def trace(self, arc_length=None, first_load_increment=0.05, max_steps=100,
+              target_load_factor=None, stop=None, on_step=None, log=None):
+        """Follow the equilibrium path from the current (w, λ), which must be converged.
+
+        Args:
+            arc_length: first Δl, in the units of the measured dofs; None: the Δl of a first
+                load increment ``first_load_increment`` along the linear tangent.
+            first_load_increment: see ``arc_length``; its sign picks the first direction.
+            max_steps: accepted steps before stopping.
+            target_load_factor: stop at the first crossing of this λ, landing on it with a
+                load-controlled Newton solve (or, if that fails, just past it). The first
+                step heads towards it; if it is the current λ, the trace runs until the path
+                comes back to it (e.g. past a limit point).
+            stop: ``stop(step) -> bool`` called after each accepted :class:`ArcLengthStep`
+                (collectively, with ``w`` at the new point); True ends the trace.
+            on_step: called with each accepted :class:`ArcLengthStep`.
+            log: callable for one-line progress messages.
+
+        Returns:
+            :class:`ArcLengthResult`.
+
+        Raises:
+            SolveFailed: when Δl falls below ``min_arc_length`` times the first Δl; names the
+                step, the last converged λ and the residual history of every attempt.
+        """
+        t_start = time.perf_counter()
+        s = self.settings
+        lam = float(self.lam.value)
+        self._load()
+        self.f_norm = math.sqrt(self.ff)
+        if self.f_norm == 0:
+            raise ValueError("the load vector is zero: F does not depend on the load factor")
+        if arc_length is None:
+            t = self._tangent(lam)
+            arc_length = abs(first_load_increment) * math.sqrt(self._dot(t, t) + s.psi**2 * self.ff)
+            t.destroy()
+        sign = math.copysign(1.0, first_load_increment)
+        if target_load_factor is not None and target_load_factor != lam:
+            sign = math.copysign(1.0, target_load_factor - lam)
+        dl0 = dl = float(arc_length)
+        direction, steps, tried = sign, [], []
+        saved = self.w.vector.copy()
+        reason = "max_steps"
+        while len(steps) < max_steps:
+            self.w.vector.copy(saved)
+            try:
+                dw, dlam, its, res = self._step(lam, dl, direction)
+            except _StepFailed as e:
+                self._restore(saved, lam)
+                tried.append((dl, e.args[0], e.args[1] if len(e.args) > 1 else ()))
+                if log:
+                    log(f"step {len(steps) + 1}: arc length {dl:.4g} failed ({e.args[0]}); halving it")
+                dl /= 2
+                if dl < s.min_arc_length * dl0:
+                    raise SolveFailed(self._failure(len(steps) + 1, lam, tried), steps) from None
+                continue
+            reached = target_load_factor is not None and (
+                (lam - target_load_factor) * (lam + dlam - target_load_factor) < 0
+                or lam + dlam == target_load_factor
+            )
+            if reached and lam + dlam != target_load_factor:
+                landed = self._land(saved, lam, dw, dlam, target_load_factor)
+                if landed:
+                    dw, dlam, its, res = landed
+            length = math.sqrt(self._dot(dw, dw) + s.psi**2 * dlam**2 * self.ff)
+            step = ArcLengthStep(len(steps) + 1, lam + dlam, length, its, res, len(tried))
+            steps.append(step)
+            lam, tried = lam + dlam, []
+            if log:
+                log(f"step {step.step}: load factor {lam:.6g}, arc length {length:.4g}, "
+                    f"{its} iterations, |R| {res[-1]:.3e}")
+            if on_step:
+                on_step(step)
+            if isinstance(direction, tuple):
+                direction[0].destroy()
+            direction = (dw, dlam)
+            if reached:
+                reason = "target"
+                break
+            if stop is not None and stop(step):
+                reason = "stop"
+                break
+            ratio = min(s.max_growth, max(0.5, math.sqrt(s.desired_iterations / max(its, 1))))
+            dl = min(dl * ratio, s.max_arc_length * dl0)
+        saved.destroy()
+        self.lam.value = lam
+        seconds = {**self.seconds, "total": time.perf_counter() - t_start}
+        return ArcLengthResult(tuple(steps), reason, seconds)
+
+    def _land(self, saved, lam, dw, dlam, target):
+        """Redo the step that crossed ``target`` at fixed λ = target; None if that fails."""
+        crossed = self.w.vector.copy()
+        self._restore(saved, lam)
+        try:
+            dw_t, dlam_t, its, res = self._step(lam, 0.0, (dw, dlam), land_at=target)
+        except _StepFailed:
+            crossed.copy(self.w.vector)
+            self.w.x.scatter_forward()
+            self.lam.value = lam + dlam
+            return None
+        finally:
+            crossed.destroy()
+        dw.destroy()
+        return dw_t, dlam_t, its, res
+
+    def _restore(self, saved, lam):
+        saved.copy(self.w.vector)
+        self.w.x.scatter_forward()
+        self.lam.value = lam
+
+    @staticmethod
+    def _failure(step, lam, tried):
+        lines = "\n".join(
+            f"  arc length {dl:.4g}: {why}, |R| = " + ", ".join(f"{r:.3e}" for r in res)
+            for dl, why, res in tried
+        )
+        return (f"arc-length continuation failed at step {step} after {len(tried)} attempts, the "
+                f"last converged load factor is {lam:.6g}; tried:\n{lines}")
+
+    def destroy(self):
+        for obj in (self.ksp, self.A, self.R, self.f, self.dw_R, self.dw_f):
+            obj.destroy()

@@ -1,0 +1,302 @@
+"""Output: probes and nodal fields against the exact roll-up, files parsed back, JSON, logging.
+
+The roll-up: a straight cantilever of length L under an end moment M about -y bends into a
+circular arc of curvature κ = M/EI; with φ = κL the tip is at
+x = L sin φ / φ, z = L (1 - cos φ) / φ, turned by φ about -y, and everywhere N = 0 and
+M_y = -M (section axes = global axes here, since Λ0 = I). With k = M L / (2π EI) = 1/2 the
+beam is a half circle: tip at (0, 0, 2L/π) turned by π.
+
+MPI: probes are the same on every rank; nodal fields and files live on rank 0, where they
+are checked (the file name is rank 0's tmp_path).
+"""
+
+import io
+import json
+import os
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from beamfx.analyses.model import BeamModel
+from beamfx.analyses.spec import Beam, Model, PointLoad, Support
+from beamfx.analyses.static import solve_static
+from beamfx.geometry import Line
+from beamfx.io import (
+    Progress,
+    PvdSeries,
+    XdmfSeries,
+    check_writable,
+    evaluate_points,
+    log,
+    nodal_fields,
+    track_rotations,
+    write_json_atomic,
+    write_vtu,
+)
+from beamfx.io._sections import rotation_matrices
+from beamfx.physics.kinematics import Kinematics
+from beamfx.physics.rotations import np_quaternion, np_rotation
+from beamfx.physics.sections import Section
+
+comm = MPI.COMM_WORLD
+L, EI = 10.0, 215e3
+SECTION = Section(EA=1770e3, GA_y=1770e3, GA_z=1770e3, GJ=8.16e3, EI_y=EI, EI_z=EI)
+ELEMENTS, DEGREE = 8, 3
+# tip error of this mesh in the two-turn roll-up is 1.4e-5 L (notes §11), at half a turn 5e-10 L;
+# the stress resultants converge at O(h^4) and are off by 3e-6 here
+TOL_POSITION, TOL_MOMENT = 1e-5, 1e-5
+
+
+def rollup_model(turns):
+    M = turns * 2 * np.pi * EI / L
+    spec = Model(
+        beams=(Beam("b", Line((0, 0, 0), (L, 0, 0)), SECTION, ELEMENTS, DEGREE),),
+        supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
+        point_loads=(PointLoad("b:end", moment=(0, -M, 0)),),
+    )
+    return BeamModel(spec), M
+
+
+def exact_tip(phi):
+    return np.array([L * np.sin(phi) / phi, 0.0, L * (1 - np.cos(phi)) / phi])
+
+
+def shared_tmp(tmp_path):
+    """Rank 0's tmp_path on every rank (writers write on rank 0 only)."""
+    return comm.bcast(str(tmp_path), root=0)
+
+
+@pytest.fixture(scope="module")
+def half_circle():
+    model, M = rollup_model(0.5)
+    solve_static(model, steps=4)
+    return model, M
+
+
+def test_probes_match_exact_half_circle(half_circle):
+    model, M = half_circle
+    pts = evaluate_points(model)
+    tip, root = pts["b:end"], pts["b:start"]
+
+    assert np.linalg.norm(np.array(tip["position"]) - exact_tip(np.pi)) < TOL_POSITION * L
+    assert np.allclose(tip["displacement"], exact_tip(np.pi) - [L, 0, 0], atol=TOL_POSITION * L)
+    assert tip["angle"] == pytest.approx(np.pi, abs=TOL_POSITION)
+    assert np.allclose(tip["axis"], [0, -1, 0], atol=1e-8)
+    assert np.linalg.norm(tip["rotation_vector"]) <= np.pi + 1e-12
+    # half a turn about -y: the section's x axis points back along -x
+    axes = np.array(tip["section_axes"])
+    assert np.allclose(axes, np.diag([-1.0, 1.0, -1.0]), atol=TOL_POSITION)
+    assert np.allclose(axes.T @ axes, np.eye(3), atol=1e-12)
+
+    assert np.allclose(root["position"], 0.0, atol=1e-12)
+    assert root["angle"] == pytest.approx(0.0, abs=1e-12)
+    for p in (tip, root):
+        assert p["section_moment"][1] == pytest.approx(-M, rel=TOL_MOMENT)
+        assert np.allclose(np.array(p["section_moment"])[[0, 2]], 0.0, atol=1e-8 * M)
+        assert np.allclose(p["section_force"], 0.0, atol=1e-8 * M / L)
+    assert (
+        comm.allgather(json.dumps(pts, sort_keys=True))
+        == [json.dumps(pts, sort_keys=True)] * comm.size
+    )
+
+
+def test_nodal_fields_moment_constant_and_recovery(half_circle):
+    model, M = half_circle
+    f = nodal_fields(model)
+    raw = nodal_fields(model, recover=False)
+    if comm.rank != 0:
+        assert f is None and raw is None
+        return
+    n = ELEMENTS * (DEGREE + 1)
+    assert f["X"].shape == f["u"].shape == f["e1"].shape == f["N"].shape == (n, 3)
+    assert f["cells"].shape == (ELEMENTS * DEGREE, 2)
+    assert np.all(np.diff(f["X"][:, 0]) >= 0)  # cells in order along the beam
+    assert np.allclose(f["M"][:, 1], -M, rtol=TOL_MOMENT)
+    assert np.allclose(f["N"], 0.0, atol=1e-8 * M / L)
+    # pointwise values at the cell ends are off by far more: the reason for the recovery
+    assert np.abs(raw["N"]).max() > 1e-3 * M / L
+    # the frame is orthonormal and e1 is the tangent of the deformed centre line
+    E = np.stack([f["e1"], f["e2"], f["e3"]], axis=2)
+    assert np.allclose(np.einsum("nki,nkj->nij", E, E), np.eye(3), atol=1e-12)
+    s = f["X"][:, 0]
+    kappa = np.pi / L
+    tangent = np.stack([np.cos(kappa * s), 0 * s, np.sin(kappa * s)], axis=1)
+    assert np.allclose(f["e1"], tangent, atol=TOL_POSITION)
+
+
+def test_track_rotations_two_turns():
+    """Roll-up to two full turns: the unwrapped tip angle follows 4πλ, the raw one does not."""
+    model, _ = rollup_model(2.0)
+    history = []
+
+    def on_step(step):
+        previous = history[-1][1] if history else None
+        history.append((step.load_factor, track_rotations(previous, evaluate_points(model))))
+
+    solve_static(model, steps=20, on_step=on_step)
+    lam = np.array([h[0] for h in history])
+    unwrapped = np.array([h[1]["b:end"]["angle_unwrapped"] for h in history])
+    assert np.allclose(unwrapped, 4 * np.pi * lam, atol=1e-4)
+    tip = history[-1][1]["b:end"]
+    assert np.allclose(tip["rotation_vector_unwrapped"], [0, -4 * np.pi, 0], atol=1e-4)
+    assert tip["angle"] == pytest.approx(0.0, abs=1e-4) or tip["angle"] == pytest.approx(
+        2 * np.pi, abs=1e-4
+    )
+    assert np.linalg.norm(tip["position"]) < 2e-5 * L  # exact tip: back at the clamp
+
+
+def test_track_rotations_follows_quaternion_path():
+    axis = np.array([1.0, 2.0, -2.0]) / 3
+    previous = None
+    for angle in np.arange(0.0, 5 * np.pi, 0.4):
+        q = np_quaternion(axis, angle)
+        current = {"p": {"quaternion": q.tolist(), "rotation_vector": [0.0, 0.0, 0.0]}}
+        previous = track_rotations(previous, current)
+        assert np.allclose(previous["p"]["rotation_vector_unwrapped"], angle * axis, atol=1e-12)
+
+
+def test_rotation_matrices_match_physics():
+    rng = np.random.default_rng(1)
+    q = rng.normal(size=(5, 4))
+    assert np.allclose(rotation_matrices(True, q), np_rotation(q), atol=1e-14)
+    theta = rng.normal(size=(5, 3))
+    theta[0] = 1e-10
+    R = rotation_matrices(False, theta)
+    for t, Ri in zip(theta, R):
+        angle = np.linalg.norm(t)
+        assert np.allclose(Ri, np_rotation(np_quaternion(t, angle)), atol=1e-14)
+
+
+def test_linear_cantilever_resultants_exact():
+    """Linear Timoshenko cantilever, tip force P: N = P and M_y = -P (L - s), reproduced
+    exactly by the recovery (polynomials of degree < k), and the tip deflection is exact."""
+    P = 100.0
+    spec = Model(
+        beams=(Beam("b", Line((0, 0, 0), (L, 0, 0)), SECTION, 4, 2),),
+        supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
+        point_loads=(PointLoad("b:end", force=(0, 0, P)),),
+        kinematics=Kinematics(finite=False),
+    )
+    model = BeamModel(spec)
+    solve_static(model)
+    tip = evaluate_points(model, ["b:end"])["b:end"]
+    w = P * L**3 / (3 * EI) + P * L / SECTION.GA_z
+    assert tip["position"][2] == pytest.approx(w, rel=1e-10)
+    assert tip["rotation_vector"][1] == pytest.approx(-P * L**2 / (2 * EI), rel=1e-10)
+    assert "quaternion" not in tip
+    f = nodal_fields(model)
+    if comm.rank == 0:
+        s = f["X"][:, 0]
+        assert np.allclose(f["M"][:, 1], -P * (L - s), atol=1e-9 * P * L)
+        assert np.allclose(f["N"][:, 2], P, atol=1e-9 * P)
+
+
+def _parse_vtu(path):
+    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    arrays = {}
+    for parent in ("PointData", "Points", "Cells"):
+        for a in piece.find(parent).findall("DataArray"):
+            values = np.array(a.text.split(), dtype=float)
+            ncomp = int(a.get("NumberOfComponents", "1"))
+            arrays[a.get("Name", parent)] = values.reshape(-1, ncomp)
+    return int(piece.get("NumberOfPoints")), int(piece.get("NumberOfCells")), arrays
+
+
+def test_paraview_files_parse_back(half_circle, tmp_path):
+    model, _ = half_circle
+    folder = shared_tmp(tmp_path)
+    check_writable(folder)
+    f = nodal_fields(model)
+    pvd = PvdSeries(os.path.join(folder, "beam.pvd"))
+    xdmf = XdmfSeries(os.path.join(folder, "beam.xdmf"))
+    for step, t in enumerate((0.5, 1.0)):
+        vtu = os.path.join(folder, f"beam_{step}.vtu")
+        write_vtu(vtu, f)
+        pvd.add(t, vtu)
+        xdmf.add(t, f)
+        if comm.rank == 0:  # both series are complete, valid files after every step
+            assert len(list(ET.parse(os.path.join(folder, "beam.xdmf")).iter("Time"))) == step + 1
+            assert len(list(ET.parse(os.path.join(folder, "beam.pvd")).iter("DataSet"))) == step + 1
+    if comm.rank != 0:
+        return
+    n_pts, n_cells = ELEMENTS * (DEGREE + 1), ELEMENTS * DEGREE
+
+    n, nc, arrays = _parse_vtu(os.path.join(folder, "beam_1.vtu"))
+    assert (n, nc) == (n_pts, n_cells)
+    for name in ("X", "u", "e1", "e2", "e3", "N", "M", "Points"):
+        assert arrays[name].shape == (n_pts, 3), name
+    assert np.allclose(arrays["Points"], f["X"] + f["u"], rtol=1e-15, atol=0)
+    assert arrays["connectivity"].size == 2 * n_cells
+    assert arrays["connectivity"].max() == n_pts - 1
+    assert np.all(arrays["types"] == 3)
+
+    sets = ET.parse(os.path.join(folder, "beam.pvd")).getroot().findall("Collection/DataSet")
+    assert [float(d.get("timestep")) for d in sets] == [0.5, 1.0]
+    assert all(os.path.exists(os.path.join(folder, d.get("file"))) for d in sets)
+    assert all(not os.path.isabs(d.get("file")) for d in sets)
+
+    series = ET.parse(os.path.join(folder, "beam.xdmf")).getroot().find("Domain/Grid")
+    assert series.get("CollectionType") == "Temporal"
+    grids = series.findall("Grid")
+    assert [float(g.find("Time").get("Value")) for g in grids] == [0.5, 1.0]
+    for g in grids:
+        topo = g.find("Topology")
+        assert (topo.get("TopologyType"), topo.get("NodesPerElement")) == ("Polyline", "2")
+        assert np.array(topo.find("DataItem").text.split(), int).size == 2 * n_cells
+        geo = g.find("Geometry/DataItem")
+        assert np.array(geo.text.split(), float).reshape(-1, 3).shape == (n_pts, 3)
+        atts = {a.get("Name"): a for a in g.findall("Attribute")}
+        assert {"X", "u", "e1", "e2", "e3", "N", "M"} <= set(atts)
+        for name in ("u", "N", "M"):
+            assert atts[name].get("AttributeType") == "Vector"
+            assert atts[name].find("DataItem").get("Format") == "XML"
+            assert np.array(atts[name].find("DataItem").text.split(), float).size == 3 * n_pts
+
+
+def test_json_atomic_and_writable(tmp_path):
+    folder = shared_tmp(tmp_path)
+    path = os.path.join(folder, "out", "result.json")
+    check_writable(os.path.dirname(path))
+    obj = {"a": np.arange(3), "b": np.float64(1.5), "c": {"d": np.eye(2)}}
+    write_json_atomic(path, obj)
+    write_json_atomic(path, {**obj, "b": 2.5})  # replaces
+    comm.barrier()
+    if comm.rank == 0:
+        with open(path) as fh:
+            assert json.load(fh) == {"a": [0, 1, 2], "b": 2.5, "c": {"d": [[1.0, 0.0], [0.0, 1.0]]}}
+        assert os.listdir(os.path.dirname(path)) == ["result.json"]  # no temporary left
+        with open(os.path.join(folder, "a_file"), "w") as fh:
+            fh.write("x")
+    bad = os.path.join(folder, "a_file", "results")
+    with pytest.raises(OSError, match="cannot write results to .*a_file"):
+        check_writable(bad)
+
+
+class _Tty(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_log_and_progress(capsys):
+    log("hello")
+    out = capsys.readouterr().out
+    assert out == ("hello\n" if comm.rank == 0 else "")
+    plain = io.StringIO()
+    with Progress(3, "steps", stream=plain) as p:
+        for i in range(1, 4):
+            p.update(i, f"λ = {i / 3:.2f}")
+    tty = _Tty()
+    with Progress(2, "steps", stream=tty) as p:
+        p.update(1, "long note")
+        p.update(2)
+    if comm.rank == 0:
+        assert plain.getvalue().splitlines() == [
+            "steps 1/3 λ = 0.33",
+            "steps 2/3 λ = 0.67",
+            "steps 3/3 λ = 1.00",
+        ]
+        assert tty.getvalue() == "\rsteps 1/2 long note\rsteps 2/2" + " " * 10 + "\n"
+    else:
+        assert plain.getvalue() == tty.getvalue() == ""
