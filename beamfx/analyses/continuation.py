@@ -2,7 +2,7 @@
 
 The path is parametrised by the load factor λ of ``model.F = F_int(w) - λ F_ext(w)`` and the
 displacement of one named point; the arc length measures the displacement dofs only (the
-``W.sub(0)`` dofs), so that quaternion components do not weigh in (Crisfield 1981, §3).
+``W.sub(0)`` dofs), so that quaternion components do not weigh in.
 """
 
 import time
@@ -52,8 +52,10 @@ def point_displacement_dofs(model, at):
     from dolfinx import fem
 
     if at not in model.mesh.points:
-        raise ValueError(f"{at!r} is not a named point of the model; named points are "
-                         f"{sorted(model.mesh.points)} (supports, loads and springs)")
+        raise ValueError(
+            f"{at!r} is not a named point of the model; named points are "
+            f"{sorted(model.mesh.points)} (supports, loads and springs)"
+        )
     verts = model.mesh.point_tags.find(model.mesh.points[at][0])
     owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
     out = []
@@ -75,13 +77,27 @@ def point_displacement(model, dofs):
 def _check_model(model):
     for sup in model.spec.supports:
         if np.any(sup.displacement) or np.any(sup.rotation):
-            raise ValueError(f"support at {sup.at!r} prescribes a displacement or rotation: "
-                             "arc-length continuation scales loads only (use solve_static)")
+            raise ValueError(
+                f"support at {sup.at!r} prescribes a displacement or rotation: "
+                "arc-length continuation scales loads only (use solve_static)"
+            )
 
 
-def trace_path(model, control_point=None, max_steps=100, target_load_factor=None, arc_length=None,
-               first_load_increment=0.05, displacement_limit=None, stop=None, settings=None,
-               options=None, prefix="beamfx_arclength_", on_step=None, log=None):
+def trace_path(
+    model,
+    control_point=None,
+    max_steps=100,
+    target_load_factor=None,
+    arc_length=None,
+    first_load_increment=0.05,
+    displacement_limit=None,
+    stop=None,
+    settings=None,
+    options=None,
+    prefix="beamfx_arclength_",
+    on_step=None,
+    log=None,
+):
     """Follow the equilibrium path of ``model`` from its current state by arc length.
 
     Crisfield's cylindrical arc length on the displacement dofs (ψ = 0 by default) with a
@@ -124,7 +140,9 @@ def trace_path(model, control_point=None, max_steps=100, target_load_factor=None
     if displacement_limit is not None:
         comp, limit = displacement_limit
         if comp not in DOF_NAMES[:3]:
-            raise ValueError(f"displacement_limit component must be one of {DOF_NAMES[:3]}, got {comp!r}")
+            raise ValueError(
+                f"displacement_limit component must be one of {DOF_NAMES[:3]}, got {comp!r}"
+            )
         comp = DOF_NAMES.index(comp)
 
     follower = any(ld.follower for ld in (*spec.point_loads, *spec.distributed_loads))
@@ -132,15 +150,26 @@ def trace_path(model, control_point=None, max_steps=100, target_load_factor=None
     settings = replace(base, follower=base.follower or follower)
     c0 = compile_seconds[0]
     _, u_dofs = model.W.sub(0).collapse()
-    solver = ArcLengthSolver(model.F, model.J, model.w, model.load_factor, model.bcs, prefix,
-                             options, settings, norm_dofs=np.asarray(u_dofs))
+    solver = ArcLengthSolver(
+        model.F,
+        model.J,
+        model.w,
+        model.load_factor,
+        model.bcs,
+        prefix,
+        options,
+        settings,
+        norm_dofs=np.asarray(u_dofs),
+    )
     compile_time = compile_seconds[0] - c0
 
     path = [PathPoint(float(model.load_factor.value), point_displacement(model, dofs), 0, 0.0)]
 
     def record(step):
         s = path[-1].arc_length + step.arc_length
-        path.append(PathPoint(step.load_factor, point_displacement(model, dofs), step.iterations, s))
+        path.append(
+            PathPoint(step.load_factor, point_displacement(model, dofs), step.iterations, s)
+        )
         if on_step:
             on_step(path[-1])
 
@@ -150,8 +179,9 @@ def trace_path(model, control_point=None, max_steps=100, target_load_factor=None
         return bool(stop is not None and stop(path))
 
     try:
-        result = solver.trace(arc_length, first_load_increment, max_steps, target_load_factor,
-                              stop_here, record, log)
+        result = solver.trace(
+            arc_length, first_load_increment, max_steps, target_load_factor, stop_here, record, log
+        )
     finally:
         solver.destroy()
     model.set_load_factor(float(model.load_factor.value))  # the support values follow λ
@@ -179,10 +209,16 @@ def limit_points(path):
         rise, fall = lam[i] - lam[i - 1], lam[i + 1] - lam[i]
         if rise * fall >= 0:
             continue
-        x = s[i - 1:i + 2]
-        c = np.polyfit(x - x[1], lam[i - 1:i + 2], 2)
+        x = s[i - 1 : i + 2]
+        c = np.polyfit(x - x[1], lam[i - 1 : i + 2], 2)
         ds = -c[1] / (2 * c[0])
-        du = [np.polyval(np.polyfit(x - x[1], u[i - 1:i + 2, k], 2), ds) for k in range(3)]
-        out.append(LimitPoint("maximum" if rise > 0 else "minimum", float(np.polyval(c, ds)),
-                              np.array(du), float(x[1] + ds)))
+        du = [np.polyval(np.polyfit(x - x[1], u[i - 1 : i + 2, k], 2), ds) for k in range(3)]
+        out.append(
+            LimitPoint(
+                "maximum" if rise > 0 else "minimum",
+                float(np.polyval(c, ds)),
+                np.array(du),
+                float(x[1] + ds),
+            )
+        )
     return out

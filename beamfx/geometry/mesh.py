@@ -41,8 +41,8 @@ def _element_breaks(spec):
     cuts = [c for i, c in enumerate(cuts) if i == 0 or c - cuts[i - 1] > 1e-12 * L]
     spans = np.diff(cuts)
     n = np.maximum(1, np.round(spans / L * spec.elements)).astype(int)
-    while n.sum() > max(spec.elements, len(spans)):  # keep the requested total
-        n[np.argmax(n / spans)] -= 1
+    while n.sum() > max(spec.elements, len(spans)):  # keep the requested total, ≥ 1 per span
+        n[np.argmax(np.where(n > 1, n / spans, -np.inf))] -= 1
     while n.sum() < spec.elements:
         n[np.argmax(spans / n)] += 1
     return np.concatenate(

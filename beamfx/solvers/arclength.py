@@ -127,8 +127,9 @@ class ArcLengthSolver:
             (the matrix S); None measures all dofs.
     """
 
-    def __init__(self, F, J, w, load_factor, bcs, prefix, options=None, settings=None,
-                 norm_dofs=None):
+    def __init__(
+        self, F, J, w, load_factor, bcs, prefix, options=None, settings=None, norm_dofs=None
+    ):
         import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
 
@@ -144,7 +145,9 @@ class ArcLengthSolver:
         self.dw_R, self.dw_f = self.R.duplicate(), self.R.duplicate()
         self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0}
 
-        n_owned = w.function_space.dofmap.index_map.size_local * w.function_space.dofmap.index_map_bs
+        n_owned = (
+            w.function_space.dofmap.index_map.size_local * w.function_space.dofmap.index_map_bs
+        )
         if norm_dofs is None:
             self.norm_dofs = slice(None)
         else:
@@ -232,7 +235,9 @@ class ArcLengthSolver:
         """a^T S b over the owned dofs of all ranks."""
         from mpi4py import MPI
 
-        local = np.dot(a.getArray(readonly=True)[self.norm_dofs], b.getArray(readonly=True)[self.norm_dofs])
+        local = np.dot(
+            a.getArray(readonly=True)[self.norm_dofs], b.getArray(readonly=True)[self.norm_dofs]
+        )
         return self.comm.allreduce(float(local), op=MPI.SUM)
 
     def _add(self, vec, alpha=1.0):
@@ -287,7 +292,9 @@ class ArcLengthSolver:
             tol = s.atol + s.rtol * self.f_norm * max(1.0, abs(lam_n + dlam))
             if residuals[-1] <= tol or small:
                 return dw, dlam, it, tuple(residuals)
-            if not np.isfinite(residuals[-1]) or residuals[-1] > s.divergence * max(residuals[0], tol):
+            if not np.isfinite(residuals[-1]) or residuals[-1] > s.divergence * max(
+                residuals[0], tol
+            ):
                 raise _StepFailed("diverged", tuple(residuals))
             if it == s.max_iterations:
                 break
@@ -335,8 +342,16 @@ class ArcLengthSolver:
 
     # --- the path --------------------------------------------------------------------------
 
-    def trace(self, arc_length=None, first_load_increment=0.05, max_steps=100,
-              target_load_factor=None, stop=None, on_step=None, log=None):
+    def trace(
+        self,
+        arc_length=None,
+        first_load_increment=0.05,
+        max_steps=100,
+        target_load_factor=None,
+        stop=None,
+        on_step=None,
+        log=None,
+    ):
         """Follow the equilibrium path from the current (w, λ), which must be converged.
 
         Args:
@@ -386,7 +401,9 @@ class ArcLengthSolver:
                 self._restore(saved, lam)
                 tried.append((dl, e.args[0], e.args[1] if len(e.args) > 1 else ()))
                 if log:
-                    log(f"step {len(steps) + 1}: arc length {dl:.4g} failed ({e.args[0]}); halving it")
+                    log(
+                        f"step {len(steps) + 1}: arc length {dl:.4g} failed ({e.args[0]}); halving it"
+                    )
                 dl /= 2
                 if dl < s.min_arc_length * dl0:
                     raise SolveFailed(self._failure(len(steps) + 1, lam, tried), steps) from None
@@ -404,8 +421,10 @@ class ArcLengthSolver:
             steps.append(step)
             lam, tried = lam + dlam, []
             if log:
-                log(f"step {step.step}: load factor {lam:.6g}, arc length {length:.4g}, "
-                    f"{its} iterations, |R| {res[-1]:.3e}")
+                log(
+                    f"step {step.step}: load factor {lam:.6g}, arc length {length:.4g}, "
+                    f"{its} iterations, |R| {res[-1]:.3e}"
+                )
             if on_step:
                 on_step(step)
             if isinstance(direction, tuple):
@@ -451,8 +470,10 @@ class ArcLengthSolver:
             f"  arc length {dl:.4g}: {why}, |R| = " + ", ".join(f"{r:.3e}" for r in res)
             for dl, why, res in tried
         )
-        return (f"arc-length continuation failed at step {step} after {len(tried)} attempts, the "
-                f"last converged load factor is {lam:.6g}; tried:\n{lines}")
+        return (
+            f"arc-length continuation failed at step {step} after {len(tried)} attempts, the "
+            f"last converged load factor is {lam:.6g}; tried:\n{lines}"
+        )
 
     def destroy(self):
         for obj in (self.ksp, self.A, self.R, self.f, self.dw_R, self.dw_f):
