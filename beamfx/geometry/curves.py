@@ -153,7 +153,7 @@ class SampledCurve:
         if len(pts) < 2:
             raise ValueError("a curve needs at least two points")
         chord = np.r_[0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
-        spline = CubicSpline(chord, pts, bc_type="natural" if len(pts) > 2 else "not-a-knot")
+        spline = CubicSpline(chord, pts, bc_type="not-a-knot")
         p = np.linspace(0, chord[-1], self.samples)
         speed = np.linalg.norm(spline(p, 1), axis=1)
         s = cumulative_trapezoid(speed, p, initial=0)
@@ -183,7 +183,7 @@ def curve_from_gmsh(path, curve_tag=None, samples=400):
     """
     import gmsh
 
-    gmsh.initialize(interruptible=False)
+    gmsh.initialize()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.open(str(path))
