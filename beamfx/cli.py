@@ -5,7 +5,9 @@ import sys
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="beamfx", description="Geometrically exact 3D beams on FEniCSx.")
+    parser = argparse.ArgumentParser(
+        prog="beamfx", description="Geometrically exact 3D beams on FEniCSx."
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="solve a scene (the built-in 45-degree bend if none is given)")
     p.add_argument("scene", nargs="?")
@@ -43,8 +45,10 @@ def main(argv=None):
                 raise SceneError(f"unknown bench case(s) {unknown}; allowed: {list(all_cases())}")
             results = run_bench(args.cases or None, args.report)
             failed = [r["id"] for r in results if not r["passed"]]
-            print(f"{len(results) - len(failed)}/{len(results)} cases within tolerance" +
-                  (f"; outside: {failed}" if failed else ""))
+            print(
+                f"{len(results) - len(failed)}/{len(results)} cases within tolerance"
+                + (f"; outside: {failed}" if failed else "")
+            )
     except (SceneError, ValueError, OSError) as e:
         print(f"beamfx: error: {e}", file=sys.stderr)
         return 2

@@ -24,8 +24,16 @@ def run_scene(path=None, out_dir=None, log=None):
     from .analyses.checks import check_supported
     from .analyses.model import BeamModel
     from .analyses.static import solve_static
-    from .io import (PvdSeries, XdmfSeries, check_writable, evaluate_points, nodal_fields,
-                     track_rotations, write_json_atomic, write_vtu)
+    from .io import (
+        PvdSeries,
+        XdmfSeries,
+        check_writable,
+        evaluate_points,
+        nodal_fields,
+        track_rotations,
+        write_json_atomic,
+        write_vtu,
+    )
     from .io import log as default_log
     from .scene import load_scene
 
@@ -43,8 +51,10 @@ def run_scene(path=None, out_dir=None, log=None):
 
     log(f"beamfx: {path} -> {out}/")
     model = BeamModel(scene.model, comm, extra_points=scene.probes.values())
-    log(f"model: {len(scene.model.beams)} beam(s), {len(model.mesh.cell_beam)} local elements, degree "
-        f"{model.degree}, {model.unknowns()} unknowns, {'finite' if model.kin.finite else 'linear'} kinematics")
+    log(
+        f"model: {len(scene.model.beams)} beam(s), {len(model.mesh.cell_beam)} local elements, degree "
+        f"{model.degree}, {model.unknowns()} unknowns, {'finite' if model.kin.finite else 'linear'} kinematics"
+    )
     pvd, xdmf = PvdSeries(out / "deformed.pvd"), XdmfSeries(out / "deformed.xdmf")
     probes_path = {}
 
@@ -58,15 +68,32 @@ def run_scene(path=None, out_dir=None, log=None):
         probes_path[step.load_factor] = track_rotations(probes_path.get("_last"), values)
         probes_path["_last"] = probes_path[step.load_factor]
 
-    result = solve_static(model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log)
+    result = solve_static(
+        model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
+    )
     final = probes_path["_last"]
     results = {
-        "scene": str(path), "analysis": scene.analysis, "converged": True,
-        "model": {"beams": [b.name for b in scene.model.beams], "degree": model.degree,
-                  "unknowns": model.unknowns(), "kinematics": "finite" if model.kin.finite else "linear",
-                  "shear": model.kin.shear, "stretch": model.kin.stretch},
-        "load_steps": [{"step": s.step, "load_factor": s.load_factor, "newton_iterations": s.iterations,
-                        "residuals": list(s.residuals), "cutbacks": s.cutbacks} for s in result.steps],
+        "scene": str(path),
+        "analysis": scene.analysis,
+        "converged": True,
+        "model": {
+            "beams": [b.name for b in scene.model.beams],
+            "degree": model.degree,
+            "unknowns": model.unknowns(),
+            "kinematics": "finite" if model.kin.finite else "linear",
+            "shear": model.kin.shear,
+            "stretch": model.kin.stretch,
+        },
+        "load_steps": [
+            {
+                "step": s.step,
+                "load_factor": s.load_factor,
+                "newton_iterations": s.iterations,
+                "residuals": list(s.residuals),
+                "cutbacks": s.cutbacks,
+            }
+            for s in result.steps
+        ],
         "newton_iterations": result.newton_iterations,
         "wall_time_s": {**result.seconds, "run": time.perf_counter() - t_start},
         "probes": {name: final[at] for name, at in scene.probes.items()},
@@ -75,8 +102,10 @@ def run_scene(path=None, out_dir=None, log=None):
     write_json_atomic(results_file, results)
     log(f"done in {results['wall_time_s']['run']:.2f} s; results in {results_file}")
     for name, v in results["probes"].items():
-        log(f"  probe {name}: position {[round(x, 6) for x in v['position']]}, "
-            f"displacement {[round(x, 6) for x in v['displacement']]}")
+        log(
+            f"  probe {name}: position {[round(x, 6) for x in v['position']]}, "
+            f"displacement {[round(x, 6) for x in v['displacement']]}"
+        )
     return results
 
 

@@ -32,7 +32,9 @@ def tip(elements, degree, follower=False):
 
     beams = (replace(model_spec.beams[0], elements=elements, degree=degree),)
     loads = tuple(replace(p, follower=follower) for p in model_spec.point_loads)
-    model = BeamModel(replace(model_spec, beams=beams, point_loads=loads), extra_points=["bend:end"])
+    model = BeamModel(
+        replace(model_spec, beams=beams, point_loads=loads), extra_points=["bend:end"]
+    )
     solve_static(model, steps=10)
     return np.array(evaluate_points(model, ["bend:end"])["bend:end"]["position"]), model.unknowns()
 
@@ -43,8 +45,10 @@ for degree in (2, 3):
     for elements in (1, 2, 4, 8):
         x, n = tip(elements, degree)
         if previous is not None and np.max(np.abs(x - previous[0])) < mm:
-            log(f"P{degree}: {previous[2]} elements, {previous[1]} unknowns meet the 1 mm criterion; "
-                f"tip {np.round(previous[0], 3)}")
+            log(
+                f"P{degree}: {previous[2]} elements, {previous[1]} unknowns meet the 1 mm criterion; "
+                f"tip {np.round(previous[0], 3)}"
+            )
             break
         previous = (x, n, elements)
 

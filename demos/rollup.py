@@ -30,11 +30,13 @@ section = Section(EA=1770e3, GA_y=1770e3, GA_z=1770e3, GJ=8.16e3, EI_y=86.9e3, E
 turns = 2.0
 M = turns * 2 * np.pi * section.EI_y / L
 beam = Beam("b", Line((0, 0, 0), (L, 0, 0)), section, elements=16, degree=3)
-model = BeamModel(Model(
-    beams=(beam,),
-    supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
-    point_loads=(PointLoad("b:end", moment=(0.0, -M, 0.0)),),  # -M about y rolls towards +z
-))
+model = BeamModel(
+    Model(
+        beams=(beam,),
+        supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
+        point_loads=(PointLoad("b:end", moment=(0.0, -M, 0.0)),),  # -M about y rolls towards +z
+    )
+)
 
 # ## Solve, checking each load step against the exact circle
 # The load factor goes from 0 to 1 in 16 steps; at each accepted step we evaluate the tip and
@@ -59,8 +61,10 @@ result = solve_static(model, steps=16, on_step=check_step)
 # The tip returns to the clamp after two loops, with its rotation at $4\pi$.
 
 final = path["tip"]["b:end"]
-log(f"{result.newton_iterations} Newton iterations, solve {result.seconds['total']:.2f} s; "
-    f"largest error along the path {max(errors):.1e} L")
+log(
+    f"{result.newton_iterations} Newton iterations, solve {result.seconds['total']:.2f} s; "
+    f"largest error along the path {max(errors):.1e} L"
+)
 assert max(errors) < 1e-6, "the roll-up left the exact circle"
 assert abs(final["angle_unwrapped"] - 4 * np.pi) < 1e-6
 if MPI.COMM_WORLD.rank == 0:

@@ -2,8 +2,8 @@ import os
 
 os.environ.setdefault("SETUPTOOLS_USE_DISTUTILS", "stdlib")
 
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import numpy as np
+import pytest
 
 
 def nodal(model, sub):

@@ -41,20 +41,20 @@ from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq, root
 
 __all__ = [
-    "hat",
-    "axial",
-    "quat_to_matrix",
-    "matrix_to_quat",
-    "rotation_to_axis_angle",
-    "rotation_vector",
-    "axis_angle_to_rotation",
-    "pure_end_moments",
-    "pure_end_moments_isotropic_exact",
     "RodCurve",
-    "straight_curve",
     "arc_curve",
+    "axial",
+    "axis_angle_to_rotation",
     "cantilever_shooting",
     "elastica_tip_force_exact",
+    "hat",
+    "matrix_to_quat",
+    "pure_end_moments",
+    "pure_end_moments_isotropic_exact",
+    "quat_to_matrix",
+    "rotation_to_axis_angle",
+    "rotation_vector",
+    "straight_curve",
 ]
 
 _E1 = np.array([1.0, 0.0, 0.0])
@@ -75,7 +75,9 @@ def axial(A):
 
 def quat_to_matrix(q):
     """Rotation matrix of the quaternion ``q = (w, x, y, z)`` (normalised first)."""
-    w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
+    w, x, y, z = q
+    nq = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / nq, x / nq, y / nq, z / nq
     return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -98,20 +100,44 @@ def matrix_to_quat(R):
     i = int(np.argmax(d))
     if i == 0:
         w = 0.5 * math.sqrt(1.0 + tr)
-        q = np.array([w, (R[2, 1] - R[1, 2]) / (4 * w), (R[0, 2] - R[2, 0]) / (4 * w),
-                      (R[1, 0] - R[0, 1]) / (4 * w)])
+        q = np.array(
+            [
+                w,
+                (R[2, 1] - R[1, 2]) / (4 * w),
+                (R[0, 2] - R[2, 0]) / (4 * w),
+                (R[1, 0] - R[0, 1]) / (4 * w),
+            ]
+        )
     elif i == 1:
         x = 0.5 * math.sqrt(max(0.0, 1.0 + 2 * R[0, 0] - tr))
-        q = np.array([(R[2, 1] - R[1, 2]) / (4 * x), x, (R[0, 1] + R[1, 0]) / (4 * x),
-                      (R[0, 2] + R[2, 0]) / (4 * x)])
+        q = np.array(
+            [
+                (R[2, 1] - R[1, 2]) / (4 * x),
+                x,
+                (R[0, 1] + R[1, 0]) / (4 * x),
+                (R[0, 2] + R[2, 0]) / (4 * x),
+            ]
+        )
     elif i == 2:
         y = 0.5 * math.sqrt(max(0.0, 1.0 + 2 * R[1, 1] - tr))
-        q = np.array([(R[0, 2] - R[2, 0]) / (4 * y), (R[0, 1] + R[1, 0]) / (4 * y), y,
-                      (R[1, 2] + R[2, 1]) / (4 * y)])
+        q = np.array(
+            [
+                (R[0, 2] - R[2, 0]) / (4 * y),
+                (R[0, 1] + R[1, 0]) / (4 * y),
+                y,
+                (R[1, 2] + R[2, 1]) / (4 * y),
+            ]
+        )
     else:
         z = 0.5 * math.sqrt(max(0.0, 1.0 + 2 * R[2, 2] - tr))
-        q = np.array([(R[1, 0] - R[0, 1]) / (4 * z), (R[0, 2] + R[2, 0]) / (4 * z),
-                      (R[1, 2] + R[2, 1]) / (4 * z), z])
+        q = np.array(
+            [
+                (R[1, 0] - R[0, 1]) / (4 * z),
+                (R[0, 2] + R[2, 0]) / (4 * z),
+                (R[1, 2] + R[2, 1]) / (4 * z),
+                z,
+            ]
+        )
     q /= np.linalg.norm(q)
     return -q if q[0] < 0 else q
 
@@ -177,6 +203,13 @@ def _stiffness(C):
     raise ValueError(f"stiffness must be a 3-vector or 3x3 matrix, got shape {C.shape}")
 
 
+def _cross(a, b):
+    """Cross product of two 3-vectors (much faster than np.cross for single vectors)."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
 def _qmul_pure(q, K):
     """Right-multiply quaternion ``q`` by the pure quaternion ``(0, K)``."""
     w, x, y, z = q
@@ -194,8 +227,9 @@ def _qmul_pure(q, K):
 # ----------------------------------------------------------------------------------------
 # 1. straight rod under a pure end moment
 # ----------------------------------------------------------------------------------------
-def pure_end_moments(L, C_M, m, n_steps=None, *, rtol=1e-12, atol=1e-14,
-                     method="quaternion", return_solution=False):
+def pure_end_moments(
+    L, C_M, m, n_steps=None, *, rtol=1e-12, atol=1e-14, method="quaternion", return_solution=False
+):
     """Straight clamped rod under a tip moment that is fixed in space.
 
     The rod lies along global x at rest (``Lambda0 = I``: section axes e1 = x (axial),
@@ -230,6 +264,7 @@ def pure_end_moments(L, C_M, m, n_steps=None, *, rtol=1e-12, atol=1e-14,
     max_step = np.inf if n_steps is None else L / n_steps
 
     if method == "quaternion":
+
         def rhs(s, y):
             q = y[3:]
             R = quat_to_matrix(q)
@@ -239,6 +274,7 @@ def pure_end_moments(L, C_M, m, n_steps=None, *, rtol=1e-12, atol=1e-14,
 
         y0 = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
     elif method == "matrix":
+
         def rhs(s, y):
             R = y[3:].reshape(3, 3)
             K = Cinv @ (R.T @ m)
@@ -248,8 +284,16 @@ def pure_end_moments(L, C_M, m, n_steps=None, *, rtol=1e-12, atol=1e-14,
     else:
         raise ValueError("method must be 'quaternion' or 'matrix'")
 
-    sol = solve_ivp(rhs, (0.0, L), y0, method="DOP853", rtol=rtol, atol=atol,
-                    max_step=max_step, dense_output=return_solution)
+    sol = solve_ivp(
+        rhs,
+        (0.0, L),
+        y0,
+        method="DOP853",
+        rtol=rtol,
+        atol=atol,
+        max_step=max_step,
+        dense_output=return_solution,
+    )
     if not sol.success:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     y = sol.y[:, -1]
@@ -414,21 +458,33 @@ def _integrate_cantilever(X0, q0, L, K0, Cn_inv, Cm_inv, n, m0, rtol, atol, dens
         Lam = quat_to_matrix(q)
         nm = Lam.T @ n
         dr = Lam @ (_E1 + Cn_inv @ nm)
-        msp = m0 - np.cross(r - X0, n)
+        msp = m0 - _cross(r - X0, n)
         K = (K0_const if K0_const is not None else K0(s)) + Cm_inv @ (Lam.T @ msp)
         return np.concatenate([dr, 0.5 * _qmul_pure(q, K)])
 
     y0 = np.concatenate([X0, q0])
-    sol = solve_ivp(rhs, (0.0, L), y0, method="DOP853", rtol=rtol, atol=atol,
-                    dense_output=dense)
+    sol = solve_ivp(rhs, (0.0, L), y0, method="DOP853", rtol=rtol, atol=atol, dense_output=dense)
     if not sol.success:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     return sol
 
 
-def cantilever_shooting(curve, C_N, C_M, tip_force, tip_moment=(0.0, 0.0, 0.0),
-                        follower=False, *, follower_moment=False, L=None, n_load_steps=20,
-                        rtol=1e-12, atol=1e-14, rtol_continuation=1e-9, full_output=False):
+def cantilever_shooting(
+    curve,
+    C_N,
+    C_M,
+    tip_force,
+    tip_moment=(0.0, 0.0, 0.0),
+    follower=False,
+    *,
+    follower_moment=False,
+    L=None,
+    n_load_steps=20,
+    rtol=1e-12,
+    atol=1e-14,
+    rtol_continuation=1e-9,
+    full_output=False,
+):
     """Clamped Simo-Reissner rod with tip loads, solved by shooting.
 
     Unknowns at the clamp ``s = 0`` (where ``r = X(0)``, ``Lambda = Lambda0(0)``):
@@ -533,26 +589,34 @@ def cantilever_shooting(curve, C_N, C_M, tip_force, tip_moment=(0.0, 0.0, 0.0),
         else:
             guess = lam * x_unit
         tol = rtol if k == n_load_steps else max(rtol, rtol_continuation)
-        sol = root(residual, guess, args=(lam, tol), method="hybr",
-                   options={"xtol": 1e-13, "epsfcn": 1e-12})
+        sol = root(
+            residual, guess, args=(lam, tol), method="hybr", options={"xtol": 1e-13, "eps": 1e-6}
+        )
         x = sol.x
         res = residual(x, lam, tol)
         if np.linalg.norm(res) > 1e-7:
             raise RuntimeError(
                 f"shooting did not converge at load factor {lam}: |res| = "
-                f"{np.linalg.norm(res):.3e} ({sol.message})")
+                f"{np.linalg.norm(res):.3e} ({sol.message})"
+            )
         history.append((lam, x.copy()))
 
     if np.linalg.norm(res) > 1e-10:
         warnings.warn(f"shooting residual {np.linalg.norm(res):.2e} > 1e-10", stacklevel=2)
     n, m0 = unpack(x, 1.0)
-    sol = _integrate_cantilever(X0, q0, L, K0, Cn_inv, Cm_inv, n, m0, rtol, atol,
-                                dense=full_output)
+    sol = _integrate_cantilever(X0, q0, L, K0, Cn_inv, Cm_inv, n, m0, rtol, atol, dense=full_output)
     r_tip = sol.y[:3, -1].copy()
     Lam_tip = quat_to_matrix(sol.y[3:, -1])
     if full_output:
-        return {"r_tip": r_tip, "Lambda_tip": Lam_tip, "R_tip": Lam_tip @ Lam0L.T,
-                "n": n, "m0": m0, "residual": np.linalg.norm(res), "solution": sol}
+        return {
+            "r_tip": r_tip,
+            "Lambda_tip": Lam_tip,
+            "R_tip": Lam_tip @ Lam0L.T,
+            "n": n,
+            "m0": m0,
+            "residual": np.linalg.norm(res),
+            "solution": sol,
+        }
     return r_tip, Lam_tip
 
 
@@ -580,12 +644,22 @@ def elastica_tip_force_exact(k):
 
     def integral(a, weight):
         sa = math.sin(a)
-        f = lambda u: sq2 * weight(sa - u * u) / math.sqrt(1.0 - (sa - u * u) ** 2)  # noqa: E731
-        return quad(f, 0.0, math.sqrt(sa), epsabs=1e-15, epsrel=1e-14, limit=200)[0]
+        one_m_sa = 2.0 * math.sin(0.5 * (0.5 * math.pi - a)) ** 2  # 1 - sin a, accurately
+
+        def f(u):
+            v = sa - u * u
+            return sq2 * weight(v) / math.sqrt((one_m_sa + u * u) * (1.0 + v))
+
+        return quad(f, 0.0, math.sqrt(sa), epsabs=1e-15, epsrel=1e-13, limit=200)[0]
 
     sk = math.sqrt(k)
-    a = brentq(lambda a: integral(a, lambda v: 1.0) - sk, 1e-12, math.pi / 2 - 1e-12,
-               xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    a = brentq(
+        lambda a: integral(a, lambda v: 1.0) - sk,
+        1e-9,
+        math.pi / 2 - 1e-9,
+        xtol=1e-15,
+        rtol=4 * np.finfo(float).eps,
+    )
     w = integral(a, lambda v: v) / sk
     x = math.sqrt(2.0 * math.sin(a) / k)
     return 1.0 - x, w, a
@@ -606,8 +680,9 @@ def mattiasson(k, L=1.0, EI=1.0, **kw):
     EA = GA = 1e9 EI/L^2. Returns ``(u/L, w/L, tip rotation)``."""
     P = k * EI / L**2
     big = 1e9 * EI / L**2
-    r, R = cantilever_shooting(straight_curve(L), (big, big, big), (EI, EI, EI),
-                               (0.0, 0.0, -P), **kw)
+    r, R = cantilever_shooting(
+        straight_curve(L), (big, big, big), (EI, EI, EI), (0.0, 0.0, -P), **kw
+    )
     axis, angle = rotation_to_axis_angle(R)
     return (L - r[0]) / L, -r[2] / L, angle
 
@@ -695,8 +770,9 @@ def test_shooting_pure_moment_matches_pure_end_moments():
     m = np.array([0.3, 1.1, -0.6])
     C_M = (0.8, 1.0, 2.5)
     r1, R1 = pure_end_moments(1.0, C_M, m)
-    r2, R2 = cantilever_shooting(straight_curve(1.0), (1e3, 1e3, 1e3), C_M, (0, 0, 0), m,
-                                 n_load_steps=2)
+    r2, R2 = cantilever_shooting(
+        straight_curve(1.0), (1e3, 1e3, 1e3), C_M, (0, 0, 0), m, n_load_steps=2
+    )
     assert np.max(np.abs(r1 - r2)) < 1e-9 and np.max(np.abs(R1 - R2)) < 1e-9
 
 
@@ -742,8 +818,10 @@ def main():
     for k, ref in MATTIASSON_TABLE.items():
         got = mattiasson(k)
         ex = elastica_tip_force_exact(k)
-        print(f"  k={k:2d} shooting {_fmt(got, 10)}  exact elastica {_fmt(ex, 10)}  "
-              f"table {ref}  max|shoot-table|={np.max(np.abs(np.array(got) - ref)):.1e}")
+        print(
+            f"  k={k:2d} shooting {_fmt(got, 10)}  exact elastica {_fmt(ex, 10)}  "
+            f"table {ref}  max|shoot-table|={np.max(np.abs(np.array(got) - ref)):.1e}"
+        )
 
     print("Bathe-Bolourchi 45-degree bend, tip position:")
     for kfac, name in ((1.0, "k=1  "), (5.0 / 6.0, "k=5/6")):

@@ -7,7 +7,16 @@ import pytest
 import ufl
 from mpi4py import MPI
 
-from beamfx.geometry import Arc, BeamSpec, Helix, Line, Polyline, SampledCurve, build_mesh, curve_from_gmsh
+from beamfx.geometry import (
+    Arc,
+    BeamSpec,
+    Helix,
+    Line,
+    Polyline,
+    SampledCurve,
+    build_mesh,
+    curve_from_gmsh,
+)
 from beamfx.solvers import compile_form
 
 MESHES = Path(__file__).parent.parent / "meshes"
@@ -53,8 +62,10 @@ def test_gmsh_geo_curve_matches_the_exact_arc():
 
 
 def test_polyline_kinks_are_vertices_and_frames_share_joints():
-    frame = [BeamSpec("a", Polyline(((0, 0, 0), (1, 0, 0), (1, 1, 0))), 4),
-             BeamSpec("b", Line((1, 1, 0), (1, 1, 1)), 2)]
+    frame = [
+        BeamSpec("a", Polyline(((0, 0, 0), (1, 0, 0), (1, 1, 0))), 4),
+        BeamSpec("b", Line((1, 1, 0), (1, 1, 1)), 2),
+    ]
     bm = build_mesh(MPI.COMM_WORLD, frame, 2, {"corner": (1, 0, 0), "joint": (1, 1, 0)})
     assert set(bm.points) == {"corner", "joint"}
     n_vertices = bm.mesh.topology.index_map(0).size_global

@@ -21,18 +21,26 @@ L = 10.0
 
 def energy(model):
     return MPI.COMM_WORLD.allreduce(
-        __import__("dolfinx").fem.assemble_scalar(compile_form(model.Pi)), op=MPI.SUM)
+        __import__("dolfinx").fem.assemble_scalar(compile_form(model.Pi)), op=MPI.SUM
+    )
 
 
 def quat_mul(a, b):
-    return np.c_[a[0] * b[:, 0] - b[:, 1:] @ a[1:],
-                 a[0] * b[:, 1:] + np.outer(b[:, 0], a[1:]) + np.cross(a[1:], b[:, 1:])]
+    return np.c_[
+        a[0] * b[:, 0] - b[:, 1:] @ a[1:],
+        a[0] * b[:, 1:] + np.outer(b[:, 0], a[1:]) + np.cross(a[1:], b[:, 1:]),
+    ]
 
 
 def curved_model(n=4, p=3):
     arc = Arc((0, 0, 0), (0, 1, 0), (100, 0, 0), 45.0)
-    return BeamModel(Model((Beam("b", arc, SEC, n, p),), (Support("b:start", CLAMP),),
-                           (PointLoad("b:end", (0, 0, 600.0), (100.0, 50.0, 0.0)),)))
+    return BeamModel(
+        Model(
+            (Beam("b", arc, SEC, n, p),),
+            (Support("b:start", CLAMP),),
+            (PointLoad("b:end", (0, 0, 600.0), (100.0, 50.0, 0.0)),),
+        )
+    )
 
 
 def test_superposed_rigid_rotation_produces_no_strain():
@@ -61,7 +69,9 @@ def rollup(direction, moment_axis, k, n=16, p=3):
     M = k * 2 * np.pi * SEC.EI_y / L
     # orientation: section z normal to the bending plane's... bending about section y = moment axis
     beam = Beam("b", Line((0, 0, 0), tuple(L * d)), SEC, n, p, orientation=tuple(np.cross(d, a)))
-    return BeamModel(Model((beam,), (Support("b:start", CLAMP),), (PointLoad("b:end", moment=tuple(M * a)),)))
+    return BeamModel(
+        Model((beam,), (Support("b:start", CLAMP),), (PointLoad("b:end", moment=tuple(M * a)),))
+    )
 
 
 @pytest.mark.parametrize("steps", [1, 2, 4])
@@ -103,5 +113,7 @@ def test_rotation_matrices_stay_orthonormal_at_quadrature_points():
     _, q = ufl.split(m.w)
     R = rotation(q)
     err = ufl.inner(R.T * R - ufl.Identity(3), R.T * R - ufl.Identity(3)) * m.dx
-    val = MPI.COMM_WORLD.allreduce(__import__("dolfinx").fem.assemble_scalar(compile_form(err)), op=MPI.SUM)
+    val = MPI.COMM_WORLD.allreduce(
+        __import__("dolfinx").fem.assemble_scalar(compile_form(err)), op=MPI.SUM
+    )
     assert val < 1e-24

@@ -28,4 +28,9 @@ def test_bend45_probes_match_serial(follower):
     for name in ("bend:end", "bend:0.5"):
         for key in ("position", "rotation_vector", "section_moment"):
             a, b = np.asarray(parallel[name][key]), np.asarray(serial[name][key])
-            assert np.allclose(a, b, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(b).max())), (name, key, a, b)
+            assert np.allclose(a, b, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(b).max())), (
+                name,
+                key,
+                a,
+                b,
+            )

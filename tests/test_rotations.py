@@ -59,8 +59,11 @@ def test_ufl_hat_axial_and_quaternion_rates_agree_with_numpy():
     Q, dQ = ufl.as_vector(q.tolist()), ufl.as_vector(dq.tolist())
 
     def num(e, shape):
-        return np.array([[float(e[i, j]) for j in range(shape[1])] for i in range(shape[0])]) if len(shape) == 2 \
+        return (
+            np.array([[float(e[i, j]) for j in range(shape[1])] for i in range(shape[0])])
+            if len(shape) == 2
             else np.array([float(e[i]) for i in range(shape[0])])
+        )
 
     R = num(rotation(Q), (3, 3))
     assert np.allclose(R, np_rotation(q))
@@ -68,8 +71,14 @@ def test_ufl_hat_axial_and_quaternion_rates_agree_with_numpy():
     eps = 1e-7
     dR = (np_rotation(q + eps * dq) - np_rotation(q - eps * dq)) / (2 * eps)
     W_body, W_spatial = R.T @ dR, dR @ R.T
-    assert np.allclose(num(body_rate(Q, dQ), (3,)), [W_body[2, 1], W_body[0, 2], W_body[1, 0]], atol=1e-7)
-    assert np.allclose(num(spatial_rate(Q, dQ), (3,)), [W_spatial[2, 1], W_spatial[0, 2], W_spatial[1, 0]], atol=1e-7)
+    assert np.allclose(
+        num(body_rate(Q, dQ), (3,)), [W_body[2, 1], W_body[0, 2], W_body[1, 0]], atol=1e-7
+    )
+    assert np.allclose(
+        num(spatial_rate(Q, dQ), (3,)),
+        [W_spatial[2, 1], W_spatial[0, 2], W_spatial[1, 0]],
+        atol=1e-7,
+    )
     v = np.array([0.2, -1.0, 3.0])
     assert np.allclose(num(axial(hat(ufl.as_vector(v.tolist()))), (3,)), v)
 

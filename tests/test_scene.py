@@ -17,21 +17,44 @@ def scene_with(edit):
     return data
 
 
-@pytest.mark.parametrize("edit, words", [
-    (lambda d: d["beams"][0].update(elemnts=3), ["beams[0].elemnts", "unknown key", "elements"]),
-    (lambda d: d["beams"][0].update(elements="8"), ["beams[0].elements", "expected an integer"]),
-    (lambda d: d["beams"][0]["curve"].update(shape="circle"), ["beams[0].curve.shape", "allowed", "arc"]),
-    (lambda d: d["beams"][0]["curve"].update(angle_deg=0), ["angle_deg", "must be positive"]),
-    (lambda d: d["material"].update(E=-1.0), ["material.E", "must be positive"]),
-    (lambda d: d["beams"][0]["section"].update(type="general", EA=1.0, GA_y=1.0, GA_z=1.0, GJ=0.0,
-                                                EI_y=1.0, EI_z=1.0), ["section.GJ", "must be positive"]),
-    (lambda d: d["loads"][0].update(at="bnd:end"), ["'bnd:end'", "names no beam", "bend"]),
-    (lambda d: d["loads"][0].update(at="bend:1.5"), ["bend:1.5", "[0, 1]"]),
-    (lambda d: d["supports"][0].update(fix=["ux", "rotz"]), ["supports[0].fix", "allowed", "rz"]),
-    (lambda d: d["analysis"].update(type="dynamic"), ["analysis.type", "static"]),
-    (lambda d: d["beams"][0].update(curve={"shape": "line", "start": [0, 0, 0], "end": [0, 0, 0]}),
-     ["zero-length"]),
-])
+@pytest.mark.parametrize(
+    "edit, words",
+    [
+        (
+            lambda d: d["beams"][0].update(elemnts=3),
+            ["beams[0].elemnts", "unknown key", "elements"],
+        ),
+        (
+            lambda d: d["beams"][0].update(elements="8"),
+            ["beams[0].elements", "expected an integer"],
+        ),
+        (
+            lambda d: d["beams"][0]["curve"].update(shape="circle"),
+            ["beams[0].curve.shape", "allowed", "arc"],
+        ),
+        (lambda d: d["beams"][0]["curve"].update(angle_deg=0), ["angle_deg", "must be positive"]),
+        (lambda d: d["material"].update(E=-1.0), ["material.E", "must be positive"]),
+        (
+            lambda d: d["beams"][0]["section"].update(
+                type="general", EA=1.0, GA_y=1.0, GA_z=1.0, GJ=0.0, EI_y=1.0, EI_z=1.0
+            ),
+            ["section.GJ", "must be positive"],
+        ),
+        (lambda d: d["loads"][0].update(at="bnd:end"), ["'bnd:end'", "names no beam", "bend"]),
+        (lambda d: d["loads"][0].update(at="bend:1.5"), ["bend:1.5", "[0, 1]"]),
+        (
+            lambda d: d["supports"][0].update(fix=["ux", "rotz"]),
+            ["supports[0].fix", "allowed", "rz"],
+        ),
+        (lambda d: d["analysis"].update(type="dynamic"), ["analysis.type", "static"]),
+        (
+            lambda d: d["beams"][0].update(
+                curve={"shape": "line", "start": [0, 0, 0], "end": [0, 0, 0]}
+            ),
+            ["zero-length"],
+        ),
+    ],
+)
 def test_bad_input_names_file_key_and_allowed_values(edit, words):
     with pytest.raises(SceneError) as err:
         parse_scene(scene_with(edit), "my.toml")
@@ -71,6 +94,7 @@ def test_unwritable_output_folder_fails_before_the_solve(tmp_path):
 
 def _toml(data):
     """Minimal TOML writer for these scenes (tables, arrays of tables, inline values)."""
+
     def value(v):
         if isinstance(v, dict):
             return "{ " + ", ".join(f"{k} = {value(x)}" for k, x in v.items()) + " }"

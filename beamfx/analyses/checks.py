@@ -26,13 +26,17 @@ def free_rigid_modes(model):
     they are free when the six mode vectors, restricted to the constrained dofs, lose rank.
     """
     points = [(resolve_point(model, s.at)[2], s.fix) for s in model.supports]
-    points += [(resolve_point(model, s.at)[2], [DOF_NAMES[i] for i in range(3) if s.stiffness[i] > 0])
-               for s in model.springs]
+    points += [
+        (resolve_point(model, s.at)[2], [DOF_NAMES[i] for i in range(3) if s.stiffness[i] > 0])
+        for s in model.springs
+    ]
     if not points:
         return 6
     centre = np.mean([p for p, _ in points], axis=0)
     size = max(1.0, max(np.linalg.norm(p - centre) for p, _ in points))
-    rows = [r for p, dofs in points for r in rigid_mode_rows((p - centre) / size + centre, dofs, centre)]
+    rows = [
+        r for p, dofs in points for r in rigid_mode_rows((p - centre) / size + centre, dofs, centre)
+    ]
     if not rows:
         return 6
     sv = np.linalg.svd(np.array(rows), compute_uv=False)

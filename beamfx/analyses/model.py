@@ -26,7 +26,11 @@ def _dg0(mesh, values):
 
     values = np.asarray(values, float)
     size = 1 if values.ndim == 1 else values.shape[1]
-    V = fem.FunctionSpace(mesh, ("DG", 0)) if size == 1 else fem.VectorFunctionSpace(mesh, ("DG", 0), dim=size)
+    V = (
+        fem.FunctionSpace(mesh, ("DG", 0))
+        if size == 1
+        else fem.VectorFunctionSpace(mesh, ("DG", 0), dim=size)
+    )
     f = fem.Function(V)
     dofs = np.array([V.dofmap.cell_dofs(c)[0] for c in range(len(values))])
     f.x.array.reshape(-1, size)[dofs] = values.reshape(-1, size)
@@ -48,16 +52,23 @@ class BeamModel:
         self.spec, self.kin = model, model.kinematics
         degrees = {b.degree for b in model.beams}
         if len(degrees) != 1:
-            raise ValueError(f"all beams must have the same degree in this version, got {sorted(degrees)}")
+            raise ValueError(
+                f"all beams must have the same degree in this version, got {sorted(degrees)}"
+            )
         self.degree = p = degrees.pop()
 
         # named points: every 'at' of supports, loads, springs and probes becomes a vertex
-        ats = [x.at for x in (*model.supports, *model.point_loads, *model.springs)] + list(extra_points)
+        ats = [x.at for x in (*model.supports, *model.point_loads, *model.springs)] + list(
+            extra_points
+        )
         self.named = {at: resolve_point(model, at) for at in dict.fromkeys(ats)}
         breaks = {i: [] for i in range(len(model.beams))}
         for b, s, _ in self.named.values():
             breaks[b].append(s)
-        specs = [BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i])) for i, b in enumerate(model.beams)]
+        specs = [
+            BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i]))
+            for i, b in enumerate(model.beams)
+        ]
         self.mesh = build_mesh(comm, specs, p, {at: xyz for at, (_, _, xyz) in self.named.items()})
         m = self.mesh.mesh
         self.comm = comm
@@ -65,13 +76,20 @@ class BeamModel:
         # per-cell section data (DG0): stiffnesses, reference vector, twist
         beams = model.beams
         cb = self.mesh.cell_beam
-        secs = [b.section.with_limits(not self.kin.shear, not self.kin.stretch, b.curve.length) for b in beams]
+        secs = [
+            b.section.with_limits(not self.kin.shear, not self.kin.stretch, b.curve.length)
+            for b in beams
+        ]
         stiff = np.array([s.stiffnesses() for s in secs])[cb] if len(cb) else np.empty((0, 6))
         tangents = self._cell_tangents()
-        ref = np.array([
-            np.asarray(beams[b].orientation, float) if beams[b].orientation is not None else default_reference(t)
-            for b, t in zip(cb, tangents)
-        ]).reshape(-1, 3)
+        ref = np.array(
+            [
+                np.asarray(beams[b].orientation, float)
+                if beams[b].orientation is not None
+                else default_reference(t)
+                for b, t in zip(cb, tangents)
+            ]
+        ).reshape(-1, 3)
         twist = np.deg2rad([beams[b].twist_deg for b in cb])
         self.stiffness = _dg0(m, stiff)
         self.reference, self.twist = _dg0(m, ref), _dg0(m, twist)
@@ -105,7 +123,9 @@ class BeamModel:
         m = self.mesh.mesh
         x, dofmap = m.geometry.x, m.geometry.dofmap
         n = len(self.mesh.cell_beam)
-        d = np.array([x[dofmap.links(c)[1]] - x[dofmap.links(c)[0]] for c in range(n)]).reshape(-1, 3)
+        d = np.array([x[dofmap.links(c)[1]] - x[dofmap.links(c)[0]] for c in range(n)]).reshape(
+            -1, 3
+        )
         return d / np.maximum(np.linalg.norm(d, axis=1)[:, None], 1e-300)
 
     def point_measure(self, at):
@@ -117,7 +137,9 @@ class BeamModel:
         vertices = self.mesh.point_tags.find(tag)
         n_local = max([len(c.links(v)) for v in vertices], default=0)
         if self.comm.allreduce(n_local, op=MPI.MAX) > 2:
-            raise ValueError(f"{at!r} joins more than two elements: loads and springs there are not supported")
+            raise ValueError(
+                f"{at!r} joins more than two elements: loads and springs there are not supported"
+            )
         inner = self.comm.allreduce(n_local, op=MPI.MAX) == 2
         if inner:
             return ufl.dS(domain=m, subdomain_data=self.mesh.point_tags)(tag), "+"
@@ -152,7 +174,8 @@ class BeamModel:
             wk = energy.force_work(kin, rot, v_u, vec(dl.force), dl.follower) + energy.moment_work(
                 kin, rot, v_rot, vec(dl.moment), dl.follower
             )
-            work += wk * self._beam_dx(None if dl.beam is None else names.index(dl.beam))
+            on_beam = 1.0 if dl.beam is None else self._beam_indicator(names.index(dl.beam))
+            work += on_beam * wk * self.dx
         if any(spec.gravity):
             rho_A = self._dg0_beam_values([b.section.rho_A for b in spec.beams])
             work += rho_A * ufl.dot(vec(spec.gravity), v_u) * self.dx
@@ -165,10 +188,11 @@ class BeamModel:
     def _dg0_beam_values(self, per_beam):
         return _dg0(self.mesh.mesh, np.asarray(per_beam, float)[self.mesh.cell_beam])
 
-    def _beam_dx(self, beam_index):
-        if beam_index is None:
-            return self.dx
-        return self._dg0_beam_values([1.0 if i == beam_index else 0.0 for i in range(len(self.spec.beams))]) * self.dx
+    def _beam_indicator(self, beam_index):
+        """DG0 function: 1 on the cells of one beam, 0 elsewhere."""
+        return self._dg0_beam_values(
+            [1.0 if i == beam_index else 0.0 for i in range(len(self.spec.beams))]
+        )
 
     def _build_supports(self):
         """One scalar Dirichlet condition per fixed component; values are fem.Constants."""
@@ -180,7 +204,9 @@ class BeamModel:
         for sup in self.spec.supports:
             bad = [d for d in sup.fix if d not in DOF_NAMES]
             if bad:
-                raise ValueError(f"support at {sup.at!r}: unknown dofs {bad}; allowed {list(DOF_NAMES)}")
+                raise ValueError(
+                    f"support at {sup.at!r}: unknown dofs {bad}; allowed {list(DOF_NAMES)}"
+                )
             verts = self.mesh.point_tags.find(self.mesh.points[sup.at][0])
             targets = self._support_targets(sup)
             for sub, comp, value in targets:
@@ -207,7 +233,9 @@ class BeamModel:
                 (1, i, lambda lam, i=i: np_quaternion(axis, lam * angle)[i]) for i in range(4)
             ]
         if np.any(rot[fixed_r]):
-            raise ValueError(f"support at {sup.at!r}: a prescribed rotation needs rx, ry and rz fixed")
+            raise ValueError(
+                f"support at {sup.at!r}: a prescribed rotation needs rx, ry and rz fixed"
+            )
         return out + [(1, 1 + i, lambda lam: 0.0) for i in fixed_r]  # rotation axis normal to these
 
     # --- state -----------------------------------------------------------------------------
@@ -216,7 +244,7 @@ class BeamModel:
         """Undeformed state: u = 0 and q = (1, 0, 0, 0) (or θ = 0)."""
         self.w.x.array[:] = 0.0
         if self.kin.finite:
-            Q, dofs = self.W.sub(1).sub(0).collapse()
+            _, dofs = self.W.sub(1).sub(0).collapse()
             self.w.x.array[dofs] = 1.0
 
     def set_load_factor(self, lam):

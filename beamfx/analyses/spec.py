@@ -83,10 +83,14 @@ def resolve_point(model, at):
         ValueError: with the allowed forms, if ``at`` names no point of a beam.
     """
     names = [b.name for b in model.beams]
-    beam_name, _, where = str(at).partition(":")
+    beam_name, colon, where = str(at).partition(":")
+    if not colon:
+        raise ValueError(f"{at!r}: write 'beam:start', 'beam:end' or 'beam:<fraction of length>'")
     if beam_name not in names:
-        raise ValueError(f"{at!r} names no beam; beams are {names} (write 'beam:start', "
-                         "'beam:end' or 'beam:<fraction of length>')")
+        raise ValueError(
+            f"{at!r} names no beam; beams are {names} (write 'beam:start', "
+            "'beam:end' or 'beam:<fraction of length>')"
+        )
     b = names.index(beam_name)
     L = model.beams[b].curve.length
     if where in ("start", "end"):
@@ -95,7 +99,9 @@ def resolve_point(model, at):
         try:
             f = float(where)
         except ValueError:
-            raise ValueError(f"{at!r}: after ':' write start, end or a fraction in [0, 1]") from None
+            raise ValueError(
+                f"{at!r}: after ':' write start, end or a fraction in [0, 1]"
+            ) from None
         if not 0.0 <= f <= 1.0:
             raise ValueError(f"{at!r}: the fraction must lie in [0, 1]")
         s = f * L

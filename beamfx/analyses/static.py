@@ -47,8 +47,9 @@ def load_scale(model, F):
     return norm
 
 
-def solve_static(model, steps=10, options=None, prefix="beamfx_static_", on_step=None, log=None,
-                 solver=None):
+def solve_static(
+    model, steps=10, options=None, prefix="beamfx_static_", on_step=None, log=None, solver=None
+):
     """Nonlinear static equilibrium at load factor 1, reached by adaptive load stepping.
 
     The linear kinematics take a single step (the problem is linear). Newton's absolute

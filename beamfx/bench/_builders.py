@@ -4,11 +4,20 @@ from ..analyses.spec import Beam, Model, PointLoad, Support
 from ..geometry import Arc, Line
 from ..physics.kinematics import Kinematics
 
+FULL = Kinematics()
 CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")
 
 
-def cantilever(curve, section, elements, degree, force=(0, 0, 0), moment=(0, 0, 0), follower=False,
-               kinematics=Kinematics()):
+def cantilever(
+    curve,
+    section,
+    elements,
+    degree,
+    force=(0, 0, 0),
+    moment=(0, 0, 0),
+    follower=False,
+    kinematics=FULL,
+):
     """One clamped beam named "b" with a tip load at "b:end" (probe "tip")."""
     beam = Beam("b", curve, section, elements, degree)
     return Model(
@@ -25,5 +34,9 @@ def straight(L):
 
 def arc(geometry):
     """The arc of a reference file's ``geometry`` entry."""
-    return Arc(tuple(geometry["start"]), tuple(geometry["start_tangent"]), tuple(geometry["centre"]),
-               geometry["angle_deg"])
+    return Arc(
+        tuple(geometry["start"]),
+        tuple(geometry["start_tangent"]),
+        tuple(geometry["centre"]),
+        geometry["angle_deg"],
+    )

@@ -31,11 +31,20 @@ def _position(values):
 
 for lam in ROLL["spec"]["lambda_values"]:
     build, ref = _rollup(lam)
-    register(Case(
-        f"rollup_{lam:g}", "Simo & Vu-Quoc 1986 (classic)", f"Roll-up, tip moment {lam:g}·2πEI/L",
-        build, _position, ref, 1e-6, tuple((n, p) for p in (3, 4) for n in (4, 8, 16)), scale=L,
-        note="exact circle x = L sin φ/φ, z = L(1 - cos φ)/φ; error relative to L.",
-    ))
+    register(
+        Case(
+            f"rollup_{lam:g}",
+            "Simo & Vu-Quoc 1986 (classic)",
+            f"Roll-up, tip moment {lam:g}·2πEI/L",
+            build,
+            _position,
+            ref,
+            1e-6,
+            tuple((n, p) for p in (3, 4) for n in (4, 8, 16)),
+            scale=L,
+            note="exact circle x = L sin φ/φ, z = L(1 - cos φ)/φ; error relative to L.",
+        )
+    )
 
 MATT = reference("classic_cases.json", "MATTIASSON")
 EI_M = 1.0
@@ -46,7 +55,9 @@ def _mattiasson(row):
     k, u, w, phi = row
 
     def build(n, p):
-        return cantilever(Line((0, 0, 0), (1.0, 0, 0)), MATT_SECTION, n, p, force=(0, 0, k * EI_M)), 10
+        return cantilever(
+            Line((0, 0, 0), (1.0, 0, 0)), MATT_SECTION, n, p, force=(0, 0, k * EI_M)
+        ), 10
 
     return build, {"u": u, "w": w, "phi": phi}
 
@@ -59,9 +70,18 @@ def _elastica(values):
 for row in MATT["reference"]["table"]:
     if row[0] in (1, 5, 10):
         build, ref = _mattiasson(row)
-        register(Case(
-            f"mattiasson_k{row[0]:g}", "Mattiasson 1981 (classic)", f"Elastica cantilever, k = {row[0]:g}",
-            build, _elastica, ref, 1e-5, tuple((n, p) for p in (3, 4) for n in (4, 8, 16)), scale=1.0,
-            note="EA = GA = 1e7 EI/L^2 approximates the inextensible, unshearable rod (error ~1e-7); "
-                 "table values to 7 digits.",
-        ))
+        register(
+            Case(
+                f"mattiasson_k{row[0]:g}",
+                "Mattiasson 1981 (classic)",
+                f"Elastica cantilever, k = {row[0]:g}",
+                build,
+                _elastica,
+                ref,
+                1e-5,
+                tuple((n, p) for p in (3, 4) for n in (4, 8, 16)),
+                scale=1.0,
+                note="EA = GA = 1e7 EI/L^2 approximates the inextensible, unshearable rod (error ~1e-7); "
+                "table values to 7 digits.",
+            )
+        )

@@ -23,22 +23,46 @@ def _measure(values):
 
 
 def _build(follower):
-    return lambda n, p: (cantilever(arc(V["geometry"]), SECTION, n, p, (0, 0, F), follower=follower), 10)
+    return lambda n, p: (
+        cantilever(arc(V["geometry"]), SECTION, n, p, (0, 0, F), follower=follower),
+        10,
+    )
 
 
-register(Case(
-    "bend45_vertical", "Howcroft et al. 2016", "45-degree bend, vertical tip load",
-    _build(False), _measure, None, 1e-3, SETTINGS, scale=1.0,
-    note="published tip positions spread over x 15.54-15.9, y 46.84-47.23, z 53.37-53.71; "
-         "the check is that the converged tip lies inside that spread. 1 mm criterion: the "
-         "smallest model whose tip moves by less than 1 mm when its unknowns are doubled.",
-    extra={"published": V["reference_tip_position"], "problem_size": SIZES["published"],
-           "spread": [PUBLISHED.min(axis=0).tolist(), PUBLISHED.max(axis=0).tolist()]},
-))
-register(Case(
-    "bend45_follower", "Howcroft et al. 2016", "45-degree bend, follower tip load",
-    _build(True), _measure, None, 1e-3, SETTINGS, scale=1.0,
-    note="reference withheld: converged here (finest setting is the reference). The force "
-         "turns with the tip section (initially along global z).",
-    extra={"problem_size": SIZES["published"]},
-))
+register(
+    Case(
+        "bend45_vertical",
+        "Howcroft et al. 2016",
+        "45-degree bend, vertical tip load",
+        _build(False),
+        _measure,
+        None,
+        1e-3,
+        SETTINGS,
+        scale=1.0,
+        note="published tip positions spread over x 15.54-15.9, y 46.84-47.23, z 53.37-53.71; "
+        "the check is that the converged tip lies inside that spread. 1 mm criterion: the "
+        "smallest model whose tip moves by less than 1 mm when its unknowns are doubled.",
+        extra={
+            "published": V["reference_tip_position"],
+            "problem_size": SIZES["published"],
+            "spread": [PUBLISHED.min(axis=0).tolist(), PUBLISHED.max(axis=0).tolist()],
+        },
+    )
+)
+register(
+    Case(
+        "bend45_follower",
+        "Howcroft et al. 2016",
+        "45-degree bend, follower tip load",
+        _build(True),
+        _measure,
+        None,
+        1e-3,
+        SETTINGS,
+        scale=1.0,
+        note="reference withheld: converged here (finest setting is the reference). The force "
+        "turns with the tip section (initially along global z).",
+        extra={"problem_size": SIZES["published"]},
+    )
+)

@@ -146,8 +146,8 @@ class SampledCurve:
     _table: tuple = field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
-        from scipy.interpolate import CubicSpline
         from scipy.integrate import cumulative_trapezoid
+        from scipy.interpolate import CubicSpline
 
         pts = np.asarray(self.through, float)
         if len(pts) < 2:

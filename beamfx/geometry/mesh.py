@@ -6,6 +6,7 @@ DOLFINx distributes the cells.
 """
 
 from dataclasses import dataclass, field
+from itertools import pairwise
 from typing import NamedTuple
 
 import numpy as np
@@ -64,7 +65,7 @@ def _nodes_and_cells(specs, degree, tol):
 
     for b, spec in enumerate(specs):
         s_v = _element_breaks(spec)
-        for sa, sb in zip(s_v[:-1], s_v[1:]):
+        for sa, sb in pairwise(s_v):
             local = np.linspace(sa, sb, degree + 1)
             xyz = spec.curve.points(local)
             ends = [vertex(xyz[0]), vertex(xyz[-1])]
@@ -124,7 +125,9 @@ def build_mesh(comm, specs, degree, named_points=None):
     if vertices:
         v = np.concatenate(vertices)
         order = np.argsort(v)
-        point_tags = dolfinx.mesh.meshtags(mesh, 0, v[order].astype(np.int32), np.concatenate(values)[order])
+        point_tags = dolfinx.mesh.meshtags(
+            mesh, 0, v[order].astype(np.int32), np.concatenate(values)[order]
+        )
     else:
         point_tags = dolfinx.mesh.meshtags(mesh, 0, np.empty(0, np.int32), np.empty(0, np.int32))
     return BeamMesh(mesh, degree, tuple(specs), beam_of[original], spans[original], point_tags, ids)

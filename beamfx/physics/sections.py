@@ -103,7 +103,11 @@ def rectangle(E, G, rho, h, w, torsion="saint-venant", shear_factor=None, nu=Non
         J = max(h, w) * min(h, w) ** 3 / 3
     else:
         J = float(torsion)
-    k = shear_factor if shear_factor is not None else cowper_rectangle(E / (2 * G) - 1 if nu is None else nu)
+    k = (
+        shear_factor
+        if shear_factor is not None
+        else cowper_rectangle(E / (2 * G) - 1 if nu is None else nu)
+    )
     return _from_geometry(E, G, rho, A, I_y, I_z, J, k, k)
 
 

@@ -45,14 +45,23 @@ def _curve(t, base):
             end = tuple(s + L * x / n for s, x in zip(start, d))
         c = curves.Line(start, end)
     elif shape == "arc":
-        c = curves.Arc(t.get("start", "vec3"), t.get("start_tangent", "vec3"), t.get("centre", "vec3"),
-                       t.get("angle_deg", float, positive=True))
+        c = curves.Arc(
+            t.get("start", "vec3"),
+            t.get("start_tangent", "vec3"),
+            t.get("centre", "vec3"),
+            t.get("angle_deg", float, positive=True),
+        )
         if c.radius == 0:
             t.fail("centre", "must differ from start (zero radius)")
     elif shape == "helix":
-        c = curves.Helix(t.get("centre", "vec3"), t.get("axis", "vec3"), t.get("radius", float, positive=True),
-                         t.get("pitch", float), t.get("turns", float, positive=True),
-                         t.get("start_direction", "vec3", (1.0, 0.0, 0.0)))
+        c = curves.Helix(
+            t.get("centre", "vec3"),
+            t.get("axis", "vec3"),
+            t.get("radius", float, positive=True),
+            t.get("pitch", float),
+            t.get("turns", float, positive=True),
+            t.get("start_direction", "vec3", (1.0, 0.0, 0.0)),
+        )
     elif shape in ("polyline", "spline"):
         pts = t.get("points", list)
         if len(pts) < 2 or not all(isinstance(p, list) and len(p) == 3 for p in pts):
@@ -74,7 +83,10 @@ def _section(t, mat):
     kind = t.get("type", str, choices=SECTION_TYPES)
     k = t.get("shear_factor", float, None, positive=True)
     if kind == "general":
-        vals = {key: t.get(key, float, positive=True) for key in ("EA", "GA_y", "GA_z", "GJ", "EI_y", "EI_z")}
+        vals = {
+            key: t.get(key, float, positive=True)
+            for key in ("EA", "GA_y", "GA_z", "GJ", "EI_y", "EI_z")
+        }
         rho_A = t.get("rho_A", float, 0.0)
         rho_I = t.get("rho_I", "vec3", (0.0, 0.0, 0.0))
         t.done()
@@ -84,10 +96,25 @@ def _section(t, mat):
     E, G, rho, nu = mat
     if kind == "rectangle":
         torsion = t.get("torsion", (str, float, int), "saint-venant")
-        if isinstance(torsion, str) and torsion not in ("saint-venant", "thin-strip"):
-            t.fail("torsion", f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J")
-        s = sections.rectangle(E, G, rho, t.get("h", float, positive=True), t.get("w", float, positive=True),
-                               torsion, k, nu)
+        if (
+            isinstance(torsion, bool)
+            or (not isinstance(torsion, str) and torsion <= 0)
+            or (isinstance(torsion, str) and torsion not in ("saint-venant", "thin-strip"))
+        ):
+            t.fail(
+                "torsion",
+                f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J",
+            )
+        s = sections.rectangle(
+            E,
+            G,
+            rho,
+            t.get("h", float, positive=True),
+            t.get("w", float, positive=True),
+            torsion,
+            k,
+            nu,
+        )
     elif kind == "circle":
         s = sections.tube(E, G, rho, t.get("d", float, positive=True), 0.0, k, nu)
     else:
@@ -117,7 +144,10 @@ def _fix(t):
     fix = t.get("fix", (str, list))
     if isinstance(fix, str):
         if fix not in FIX_WORDS:
-            t.fail("fix", f"{fix!r} is not allowed; allowed: {list(FIX_WORDS)} or a list of {list(DOF_NAMES)}")
+            t.fail(
+                "fix",
+                f"{fix!r} is not allowed; allowed: {list(FIX_WORDS)} or a list of {list(DOF_NAMES)}",
+            )
         return tuple(FIX_WORDS[fix])
     bad = [d for d in fix if d not in DOF_NAMES]
     if bad or not fix:
@@ -136,19 +166,46 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             t.fail("name", f"{name!r} must be unique and contain no ':'")
         curve = _curve(t.table("curve"), base)
         section = _section(t.table("section"), mat)
-        beams.append(Beam(
-            name, curve, section, t.get("elements", int, 8, positive=True),
-            t.get("degree", int, 2, choices=(1, 2, 3, 4)), t.get("orientation", "vec3", None),
-            t.get("twist_deg", float, 0.0),
-        ))
+        beams.append(
+            Beam(
+                name,
+                curve,
+                section,
+                t.get("elements", int, 8, positive=True),
+                t.get("degree", int, 2, choices=(1, 2, 3, 4)),
+                t.get("orientation", "vec3", None),
+                t.get("twist_deg", float, 0.0),
+            )
+        )
         t.done()
     if not beams:
         top.fail("beams", "a scene needs at least one [[beams]] table")
+    if len({b.degree for b in beams}) > 1:
+        top.fail(
+            "beams",
+            f"all beams must have the same degree in this version, got {[b.degree for b in beams]}",
+        )
+    for i, b in enumerate(beams):
+        _check_orientation(b, f"{file}: beams[{i}].orientation")
 
     supports = []
     for t in top.tables("supports"):
-        supports.append(Support(t.get("at", str), _fix(t), t.get("displacement", "vec3", (0.0,) * 3),
-                                t.get("rotation", "vec3", (0.0,) * 3)))
+        sup = Support(
+            t.get("at", str),
+            _fix(t),
+            t.get("displacement", "vec3", (0.0,) * 3),
+            t.get("rotation", "vec3", (0.0,) * 3),
+        )
+        free = [
+            DOF_NAMES[i] for i in range(3) if sup.displacement[i] and DOF_NAMES[i] not in sup.fix
+        ]
+        if free:
+            t.fail(
+                "displacement", f"prescribed on {free}, which 'fix' leaves free; add them to fix"
+            )
+        if any(sup.rotation) and not {"rx", "ry", "rz"} <= set(sup.fix):
+            t.fail("rotation", "a prescribed rotation needs rx, ry and rz in fix")
+        supports.append(sup)
         t.done()
     point_loads, distributed, gravity = [], [], (0.0, 0.0, 0.0)
     for t in top.tables("loads"):
@@ -158,12 +215,26 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             continue
         kind = t.get("kind", str, "dead", choices=("dead", "follower"))
         if t.has("at"):
-            point_loads.append(PointLoad(t.get("at", str), t.get("force", "vec3", (0.0,) * 3),
-                                         t.get("moment", "vec3", (0.0,) * 3), kind == "follower"))
+            point_loads.append(
+                PointLoad(
+                    t.get("at", str),
+                    t.get("force", "vec3", (0.0,) * 3),
+                    t.get("moment", "vec3", (0.0,) * 3),
+                    kind == "follower",
+                )
+            )
         else:
-            distributed.append(DistributedLoad(t.get("beam", str, None), t.get("force_per_length", "vec3", (0.0,) * 3),
-                                               t.get("moment_per_length", "vec3", (0.0,) * 3), kind == "follower"))
-        t.done(" (a point load has 'at'; a distributed one 'beam' or neither for all beams; or 'gravity')")
+            distributed.append(
+                DistributedLoad(
+                    t.get("beam", str, None),
+                    t.get("force_per_length", "vec3", (0.0,) * 3),
+                    t.get("moment_per_length", "vec3", (0.0,) * 3),
+                    kind == "follower",
+                )
+            )
+        t.done(
+            " (a point load has 'at'; a distributed one 'beam' or neither for all beams; or 'gravity')"
+        )
     springs = []
     for t in top.tables("springs"):
         springs.append(Spring(t.get("at", str), t.get("stiffness", "vec3")))
@@ -172,7 +243,8 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     mt = top.table("model", {})
     kin = Kinematics(
         finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
-        shear=mt.get("shear", bool, True), stretch=mt.get("stretch", bool, True),
+        shear=mt.get("shear", bool, True),
+        stretch=mt.get("stretch", bool, True),
     )
     mt.done()
     at = top.table("analysis", {})
@@ -184,7 +256,10 @@ def parse_scene(data, file="<scene>", base=Path(".")):
 
     probes = {}
     for t in top.tables("probes"):
-        probes[t.get("name", str)] = t.get("at", str)
+        name = t.get("name", str)
+        if name in probes:
+            t.fail("name", f"probe {name!r} is given twice")
+        probes[name] = t.get("at", str)
         t.done()
     ot = top.table("output", {})
     out_dir = ot.get("dir", str, "results")
@@ -192,8 +267,15 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     solver = top.get("solver", dict, {})
     top.done()
 
-    model = Model(tuple(beams), tuple(supports), tuple(point_loads), tuple(distributed),
-                  tuple(springs), gravity, kin)
+    model = Model(
+        tuple(beams),
+        tuple(supports),
+        tuple(point_loads),
+        tuple(distributed),
+        tuple(springs),
+        gravity,
+        kin,
+    )
     _check_points(model, probes, file)
     return Scene(file, model, analysis, steps, probes, out_dir, dict(solver))
 
@@ -212,9 +294,32 @@ def _check_points(model, probes, file):
             raise SceneError(f"{file}: {where}: {e}") from None
     for d in model.distributed_loads:
         if d.beam is not None and d.beam not in [b.name for b in model.beams]:
-            raise SceneError(f"{file}: loads.beam: {d.beam!r} is no beam; beams are {[b.name for b in model.beams]}")
+            raise SceneError(
+                f"{file}: loads.beam: {d.beam!r} is no beam; beams are {[b.name for b in model.beams]}"
+            )
     if not model.supports:
         raise SceneError(f"{file}: supports: none given; the structure is free (rigid-body motion)")
+
+
+def _check_orientation(beam, where):
+    """The reference vector must not be parallel to the centre line anywhere."""
+    import numpy as np
+
+    if beam.orientation is None:
+        return
+    s = np.linspace(0, beam.curve.length, 201)
+    x = beam.curve.points(s)
+    t = np.diff(x, axis=0)
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    o = np.asarray(beam.orientation, float)
+    if (
+        not np.linalg.norm(o) > 0
+        or np.min(np.linalg.norm(np.cross(t, o / np.linalg.norm(o)), axis=1)) < 1e-6
+    ):
+        raise SceneError(
+            f"{where}: {list(o)} is parallel to the centre line of beam {beam.name!r} "
+            "somewhere; give a vector normal to it (the section's local z)"
+        )
 
 
 def load_scene(path):

@@ -7,8 +7,14 @@ class SceneError(ValueError):
     """Bad input in a scene file."""
 
 
-_TYPE_NAMES = {float: "a number", int: "an integer", str: "a string", bool: "true or false",
-               list: "a list", dict: "a table"}
+_TYPE_NAMES = {
+    float: "a number",
+    int: "an integer",
+    str: "a string",
+    bool: "true or false",
+    list: "a list",
+    dict: "a table",
+}
 
 
 class Table:
@@ -37,8 +43,11 @@ class Table:
             return default
         value = self.data[key]
         if kind == "vec3":
-            ok = isinstance(value, list) and len(value) == 3 and all(
-                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value)
+            ok = (
+                isinstance(value, list)
+                and len(value) == 3
+                and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value)
+            )
             if not ok:
                 self.fail(key, f"expected a list of 3 numbers, got {value!r}")
             return tuple(float(v) for v in value)
@@ -59,7 +68,11 @@ class Table:
 
     def table(self, key, default=...):
         value = self.get(key, dict, default)
-        return None if value is None else Table(value, f"{self.path + '.' if self.path else ''}{key}", self.file)
+        return (
+            None
+            if value is None
+            else Table(value, f"{self.path + '.' if self.path else ''}{key}", self.file)
+        )
 
     def tables(self, key):
         """An array of tables (``[[key]]``), each as a Table with an indexed path."""
@@ -69,4 +82,6 @@ class Table:
     def done(self, allowed_note=""):
         unknown = sorted(set(self.data) - self.used)
         if unknown:
-            self.fail(unknown[0], f"unknown key; allowed keys here: {sorted(self.used)}{allowed_note}")
+            self.fail(
+                unknown[0], f"unknown key; allowed keys here: {sorted(self.used)}{allowed_note}"
+            )

@@ -124,10 +124,18 @@ class NewtonSolver:
         seconds["solve"] = total - seconds["assemble_F"] - seconds["assemble_J"]
         self.seconds["solve"] += seconds["solve"]
         residuals = tuple(self._residuals)
-        converged = code > 0 and np.all(np.isfinite(residuals))
+        # a step-size (stol) stop is only convergence if the residual did not grow
+        converged = (
+            code > 0
+            and np.all(np.isfinite(residuals))
+            and (len(residuals) < 2 or residuals[-1] <= residuals[0])
+        )
         return SolveReport(
-            bool(converged), _reason_names().get(code, str(code)), self.snes.getIterationNumber(),
-            residuals, seconds,
+            bool(converged),
+            _reason_names().get(code, str(code)),
+            self.snes.getIterationNumber(),
+            residuals,
+            seconds,
         )
 
     def destroy(self):

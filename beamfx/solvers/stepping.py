@@ -13,8 +13,16 @@ class LoadStep(NamedTuple):
     cutbacks: int
 
 
-def step_load(solve_at, state, steps=10, min_fraction=1e-4, easy_iterations=4, growth=1.5,
-              on_step=None, log=None):
+def step_load(
+    solve_at,
+    state,
+    steps=10,
+    min_fraction=1e-4,
+    easy_iterations=4,
+    growth=1.5,
+    on_step=None,
+    log=None,
+):
     """March the load factor from 0 to 1.
 
     Args:
@@ -40,11 +48,15 @@ def step_load(solve_at, state, steps=10, min_fraction=1e-4, easy_iterations=4, g
         state.save()
         report = solve_at(target)
         if report.converged:
-            item = LoadStep(len(history) + 1, target, report.iterations, report.residuals, len(tried))
+            item = LoadStep(
+                len(history) + 1, target, report.iterations, report.residuals, len(tried)
+            )
             history.append(item)
             if log:
-                log(f"step {item.step}: load factor {target:.6g}, {report.iterations} Newton "
-                    f"iterations, |F| {report.residuals[-1] if report.residuals else 0:.3e}")
+                log(
+                    f"step {item.step}: load factor {target:.6g}, {report.iterations} Newton "
+                    f"iterations, |F| {report.residuals[-1] if report.residuals else 0:.3e}"
+                )
             if on_step:
                 on_step(item)
             lam, tried = target, []
@@ -54,8 +66,10 @@ def step_load(solve_at, state, steps=10, min_fraction=1e-4, easy_iterations=4, g
         state.restore()
         tried.append((target, report.reason, report.residuals))
         if log:
-            log(f"step {len(history) + 1}: no convergence at load factor {target:.6g} "
-                f"({report.reason}); cutting the step back")
+            log(
+                f"step {len(history) + 1}: no convergence at load factor {target:.6g} "
+                f"({report.reason}); cutting the step back"
+            )
         size /= 2
         if size < min_fraction:
             lines = "\n".join(
