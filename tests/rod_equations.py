@@ -562,6 +562,8 @@ def cantilever_shooting(
         return lam * F, x * scale_m
 
     def residual(x, lam, tol):
+        if not np.all(np.isfinite(x)):
+            return np.full(x.size, 1e10)
         n, m0 = unpack(x, lam)
         sol = _integrate_cantilever(X0, q0, L, K0, Cn_inv, Cm_inv, n, m0, tol, atol)
         r = sol.y[:3, -1]
@@ -573,6 +575,17 @@ def cantilever_shooting(
         if six:
             return np.concatenate([(n - lam * (Rinc @ F)) / scale_n, res_m])
         return res_m
+
+    def jacobian(x, lam, tol):
+        # central differences with an absolute step: the unknowns are scaled to O(1), and
+        # MINPACK's relative step breaks down for unknowns that are ~0 (e.g. 1e-75)
+        h = 1e-6
+        J = np.empty((x.size, x.size))
+        for j in range(x.size):
+            e = np.zeros(x.size)
+            e[j] = h
+            J[:, j] = (residual(x + e, lam, tol) - residual(x - e, lam, tol)) / (2 * h)
+        return J
 
     # initial guess from the undeformed geometry: m(0) = M + (X(L) - X(0)) x F
     XL = np.asarray(curve(L)[0], dtype=float)
@@ -589,9 +602,9 @@ def cantilever_shooting(
         else:
             guess = lam * x_unit
         tol = rtol if k == n_load_steps else max(rtol, rtol_continuation)
-        sol = root(
-            residual, guess, args=(lam, tol), method="hybr", options={"xtol": 1e-13, "eps": 1e-6}
-        )
+        # xtol is near the ODE noise level: cap the evaluations, the residual check decides
+        opts = {"xtol": 1e-13 if k == n_load_steps else 1e-9, "maxfev": 40 * (guess.size + 1)}
+        sol = root(residual, guess, args=(lam, tol), method="hybr", jac=jacobian, options=opts)
         x = sol.x
         res = residual(x, lam, tol)
         if np.linalg.norm(res) > 1e-7:
@@ -665,6 +678,46 @@ def elastica_tip_force_exact(k):
     return 1.0 - x, w, a
 
 
+def follower_elastica_exact(k):
+    """Inextensible cantilever with a transverse *follower* tip force (always normal to
+    the tip tangent, in the bending plane), ``k = P L^2 / EI < 3.437`` (tip rotation
+    below pi/2).
+
+    ``EI theta'' = -P cos(a - theta)``, ``theta(0) = 0``, ``theta'(L) = 0``; first integral
+    ``theta'^2 = 2 (P/EI) sin(a - theta)``. With ``sin(a - theta) = u^2``:
+
+        sqrt(k) = int_0^sqrt(sin a) sqrt2 du / sqrt(1 - u^4)
+        x/L     = sqrt(2/k) int_0^sqrt(sin a) [cos a + sin a u^2 / sqrt(1 - u^4)] du
+        w/L     = sqrt(2/k) int_0^sqrt(sin a) [sin a - cos a u^2 / sqrt(1 - u^4)] du
+
+    Returns:
+        ``(u/L, w/L, a)`` as :func:`elastica_tip_force_exact`.
+    """
+    sq2 = math.sqrt(2.0)
+
+    def integral(a, f):
+        return quad(f, 0.0, math.sqrt(math.sin(a)), epsabs=1e-15, epsrel=1e-13, limit=200)[0]
+
+    sk = math.sqrt(k)
+
+    def g(u):
+        return sq2 / math.sqrt(1.0 - u**4)
+
+    if k >= (integral(math.pi / 2 - 1e-12, g)) ** 2:
+        raise ValueError("k too large: tip rotation would exceed pi/2")
+    a = brentq(
+        lambda a: integral(a, g) - sk,
+        1e-12,
+        math.pi / 2 - 1e-12,
+        xtol=1e-15,
+        rtol=4 * np.finfo(float).eps,
+    )
+    ca, sa = math.cos(a), math.sin(a)
+    x = sq2 / sk * integral(a, lambda u: ca + sa * u * u / math.sqrt(1.0 - u**4))
+    w = sq2 / sk * integral(a, lambda u: sa - ca * u * u / math.sqrt(1.0 - u**4))
+    return 1.0 - x, w, a
+
+
 # ----------------------------------------------------------------------------------------
 # benchmark set-ups (used by the self-checks below)
 # ----------------------------------------------------------------------------------------
@@ -677,13 +730,14 @@ MATTIASSON_TABLE = {
 
 def mattiasson(k, L=1.0, EI=1.0, **kw):
     """Straight cantilever along x, dead tip force ``(0, 0, -P)``, ``P = k EI/L^2``,
-    EA = GA = 1e9 EI/L^2. Returns ``(u/L, w/L, tip rotation)``."""
+    EA = GA = 1e9 EI/L^2. Returns ``(u/L, w/L, tip rotation)``. Pass ``follower=True``
+    for the follower-force variant."""
     P = k * EI / L**2
     big = 1e9 * EI / L**2
     r, R = cantilever_shooting(
         straight_curve(L), (big, big, big), (EI, EI, EI), (0.0, 0.0, -P), **kw
     )
-    axis, angle = rotation_to_axis_angle(R)
+    _, angle = rotation_to_axis_angle(R)
     return (L - r[0]) / L, -r[2] / L, angle
 
 
@@ -764,6 +818,13 @@ def test_mattiasson_shooting():
         exact = np.array(elastica_tip_force_exact(k))
         # EA = GA = 1e9 EI/L^2 changes the answer by O(1e-9)
         assert np.max(np.abs(got - exact)) < 2e-8, (k, got - exact)
+
+
+def test_follower_cantilever_exact():
+    for k in (1.0, 3.0):
+        got = np.array(mattiasson(k, follower=True, n_load_steps=5))
+        exact = np.array(follower_elastica_exact(k))
+        assert np.max(np.abs(got - exact)) < 5e-8, (k, got - exact)
 
 
 def test_shooting_pure_moment_matches_pure_end_moments():
