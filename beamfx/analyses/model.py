@@ -15,9 +15,13 @@ from ..physics.rotations import np_quaternion
 from .spec import DOF_NAMES, resolve_point
 
 
-def default_reference(t):
-    """Global z made normal to the tangent t; global x for a centre line along z."""
-    return np.array([1.0, 0.0, 0.0]) if abs(t[2]) > 1 - 1e-8 else np.array([0.0, 0.0, 1.0])
+def default_reference(tangents):
+    """Per tangent (rows): global z, or global x where the centre line runs along z.
+
+    The section frame makes it normal to the tangent (:func:`section_frame`).
+    """
+    along_z = np.abs(np.asarray(tangents)[:, 2]) > 1 - 1e-8
+    return np.where(along_z[:, None], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
 
 
 def _dg0(mesh, values):
@@ -32,7 +36,7 @@ def _dg0(mesh, values):
         else fem.VectorFunctionSpace(mesh, ("DG", 0), dim=size)
     )
     f = fem.Function(V)
-    dofs = np.array([V.dofmap.cell_dofs(c)[0] for c in range(len(values))])
+    dofs = V.dofmap.list.array[: len(values)]  # one (blocked) dof per cell
     f.x.array.reshape(-1, size)[dofs] = values.reshape(-1, size)
     return f
 
@@ -81,15 +85,10 @@ class BeamModel:
             for b in beams
         ]
         stiff = np.array([s.stiffnesses() for s in secs])[cb] if len(cb) else np.empty((0, 6))
-        tangents = self._cell_tangents()
-        ref = np.array(
-            [
-                np.asarray(beams[b].orientation, float)
-                if beams[b].orientation is not None
-                else default_reference(t)
-                for b, t in zip(cb, tangents)
-            ]
-        ).reshape(-1, 3)
+        ref = default_reference(self._cell_tangents())
+        for i, b in enumerate(beams):
+            if b.orientation is not None:
+                ref[cb == i] = b.orientation
         twist = np.deg2rad([beams[b].twist_deg for b in cb])
         self.stiffness = _dg0(m, stiff)
         self.reference, self.twist = _dg0(m, ref), _dg0(m, twist)
@@ -102,6 +101,7 @@ class BeamModel:
         Q = ufl.VectorElement("Lagrange", cell, p, dim=self.kin.rotation_size)
         self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q]))
         self.w = fem.Function(self.W, name="unknowns")
+        self._q0_dofs = self.W.sub(1).sub(0).collapse()[1] if self.kin.finite else []
         self.reset()
 
         # measures: shear/axial with p Gauss points (exact to 2p-1), the rest with p+1
@@ -121,11 +121,8 @@ class BeamModel:
 
     def _cell_tangents(self):
         m = self.mesh.mesh
-        x, dofmap = m.geometry.x, m.geometry.dofmap
-        n = len(self.mesh.cell_beam)
-        d = np.array([x[dofmap.links(c)[1]] - x[dofmap.links(c)[0]] for c in range(n)]).reshape(
-            -1, 3
-        )
+        nodes = m.geometry.dofmap.array.reshape(-1, self.degree + 1)[: len(self.mesh.cell_beam)]
+        d = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]  # chord from end 0 to end 1
         return d / np.maximum(np.linalg.norm(d, axis=1)[:, None], 1e-300)
 
     def point_measure(self, at):
@@ -155,25 +152,25 @@ class BeamModel:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, self.dx)
         for sp in spec.springs:
             dP, side = self.point_measure(sp.at)
-            k = ufl.as_vector(sp.stiffness)
-            e = 0.5 * ufl.dot(u, ufl.dot(ufl.diag(k), u))
+            e = energy.spring_energy(u, [float(k) for k in sp.stiffness])
             Pi += (e(side) if side else e) * dP
 
         def vec(x):
             return ufl.as_vector([float(c) for c in x])
 
+        def work_of(load):
+            return energy.load_work(
+                kin, rot, v_u, v_rot, vec(load.force), vec(load.moment), load.follower
+            )
+
         work = 0
         for ld in spec.point_loads:
             dP, side = self.point_measure(ld.at)
-            wk = energy.force_work(kin, rot, v_u, vec(ld.force), ld.follower) + energy.moment_work(
-                kin, rot, v_rot, vec(ld.moment), ld.follower
-            )
+            wk = work_of(ld)
             work += (wk(side) if side else wk) * dP
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
-            wk = energy.force_work(kin, rot, v_u, vec(dl.force), dl.follower) + energy.moment_work(
-                kin, rot, v_rot, vec(dl.moment), dl.follower
-            )
+            wk = work_of(dl)
             on_beam = 1.0 if dl.beam is None else self._beam_indicator(names.index(dl.beam))
             work += on_beam * wk * self.dx
         if any(spec.gravity):
@@ -243,9 +240,7 @@ class BeamModel:
     def reset(self):
         """Undeformed state: u = 0 and q = (1, 0, 0, 0) (or θ = 0)."""
         self.w.x.array[:] = 0.0
-        if self.kin.finite:
-            _, dofs = self.W.sub(1).sub(0).collapse()
-            self.w.x.array[dofs] = 1.0
+        self.w.x.array[self._q0_dofs] = 1.0
 
     def set_load_factor(self, lam):
         """Scale loads and prescribed values (a prescribed rotation turns by lam times its angle)."""

@@ -29,21 +29,19 @@ class _State:
 
 
 def load_scale(model, F):
-    """Norm of the external load vector at full load (compiled residual ``F`` at the undeformed
-    state), to set an absolute residual tolerance in the problem's units."""
+    """Norm of the load vector at the undeformed state (compiled residual ``F``), to set an
+    absolute residual tolerance in the problem's units."""
     import dolfinx.fem.petsc as fp
-    from petsc4py import PETSc
 
-    lam, w0 = float(model.load_factor.value), model.w.x.array.copy()
+    from ..solvers.assembly import assemble_load
+
+    w0 = model.w.x.array.copy()
     model.reset()
-    model.set_load_factor(1.0)
-    b = fp.assemble_vector(F)
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    fp.set_bc(b, model.bcs, scale=0.0)
-    norm = b.norm()
-    b.destroy()
+    f = fp.create_vector(F)
+    assemble_load(f, F, model.load_factor, model.bcs)
+    norm = f.norm()
+    f.destroy()
     model.w.x.array[:] = w0
-    model.set_load_factor(lam)
     return norm
 
 

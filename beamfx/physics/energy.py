@@ -37,5 +37,10 @@ def moment_work(kin, rot, v_rot, moment, follower):
 
 
 def spring_energy(u, k):
-    """½ k |u|² of a translational spring to ground."""
-    return 0.5 * k * ufl.dot(u, u)
+    """½ u·diag(k) u of a translational spring to ground (k per global axis)."""
+    return 0.5 * ufl.dot(u, ufl.diag(ufl.as_vector(k)) * u)
+
+
+def load_work(kin, rot, v_u, v_rot, force, moment, follower):
+    """Virtual work of a force and a moment, both dead or both follower."""
+    return force_work(kin, rot, v_u, force, follower) + moment_work(kin, rot, v_rot, moment, follower)

@@ -48,6 +48,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .assembly import assemble_load, assemble_residual, assemble_tangent
 from .forms import compile_form
 from .options import petsc_options
 from .snes import SolveFailed
@@ -165,52 +166,26 @@ class ArcLengthSolver:
 
     def _residual(self, lam):
         """R(w, λ) with zero rows on the constrained dofs (w satisfies the bcs)."""
-        import dolfinx.fem.petsc as fp
-        from petsc4py import PETSc
-
         t = time.perf_counter()
         self.lam.value = lam
-        x, b = self.w.vector, self.R
-        with b.localForm() as local:
-            local.set(0.0)
-        fp.assemble_vector(b, self.F)
-        fp.apply_lifting(b, [self.J], bcs=[self.bcs], x0=[x], scale=-1.0)
-        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        fp.set_bc(b, self.bcs, x, -1.0)
+        assemble_residual(self.R, self.F, self.J, self.bcs, self.w.vector)
         self.seconds["assemble_F"] += time.perf_counter() - t
-        return b.norm()
+        return self.R.norm()
 
     def _load(self):
         """f = F(w, 0) - F(w, 1) = -∂F/∂λ at the current w, zero on constrained dofs."""
-        import dolfinx.fem.petsc as fp
-        from petsc4py import PETSc
-
         t = time.perf_counter()
-        lam = float(self.lam.value)
-        tmp = self.f.duplicate()
-        for vec, value in ((self.f, 0.0), (tmp, 1.0)):
-            self.lam.value = value
-            with vec.localForm() as local:
-                local.set(0.0)
-            fp.assemble_vector(vec, self.F)
-            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self.f.axpy(-1.0, tmp)
-        tmp.destroy()
-        fp.set_bc(self.f, self.bcs, scale=0.0)
-        self.lam.value = lam
+        assemble_load(self.f, self.F, self.lam, self.bcs)
         self.ff = self.f.dot(self.f)
         self.seconds["assemble_F"] += time.perf_counter() - t
 
     def _factor(self, lam):
         """Assemble K = ∂R/∂w at (w, λ) and factorise it."""
-        import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
 
         t = time.perf_counter()
         self.lam.value = lam
-        self.A.zeroEntries()
-        fp.assemble_matrix(self.A, self.J, bcs=self.bcs)
-        self.A.assemble()
+        assemble_tangent(self.A, self.J, self.bcs)
         self.seconds["assemble_J"] += time.perf_counter() - t
         t = time.perf_counter()
         try:

@@ -5,6 +5,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .assembly import assemble_residual, assemble_tangent
 from .forms import compile_form
 from .options import petsc_options
 
@@ -80,28 +81,18 @@ class NewtonSolver:
         self.snes = snes
 
     def _residual(self, snes, x, b):
-        import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
 
         t = time.perf_counter()
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         x.copy(self.w.vector)
         self.w.x.scatter_forward()
-        with b.localForm() as local:
-            local.set(0.0)
-        fp.assemble_vector(b, self.F)
-        fp.apply_lifting(b, [self.J], bcs=[self.bcs], x0=[x], scale=-1.0)
-        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        fp.set_bc(b, self.bcs, x, -1.0)
+        assemble_residual(b, self.F, self.J, self.bcs, x)
         self.seconds["assemble_F"] += time.perf_counter() - t
 
     def _jacobian(self, snes, x, A, P):
-        import dolfinx.fem.petsc as fp
-
         t = time.perf_counter()
-        A.zeroEntries()
-        fp.assemble_matrix(A, self.J, bcs=self.bcs)
-        A.assemble()
+        assemble_tangent(A, self.J, self.bcs)
         self.seconds["assemble_J"] += time.perf_counter() - t
 
     def set_atol(self, atol):
