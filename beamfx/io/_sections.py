@@ -25,6 +25,7 @@ import numpy as np
 import ufl
 
 from ..physics.kinematics import strains
+from ..physics.rotations import np_exp_rotation, np_rotation
 from ..solvers.forms import JIT_PARAMS
 
 _compiled = weakref.WeakKeyDictionary()  # model -> {points key: (Expression, layout)}
@@ -118,34 +119,7 @@ def evaluate(model, points, cells, recover=True):
 
 
 def rotation_matrices(finite, rot):
-    r"""Rotation matrices of an (n, 4) array of quaternions or an (n, 3) array of rotation vectors.
-
-    Quaternions of any norm: :math:`R = [(q_0^2 - v\cdot v) I + 2 v v^T + 2 q_0 \hat v]/|q|^2`
-    (as :func:`beamfx.physics.rotations.rotation`). Rotation vectors (linear kinematics): the
-    exact exponential map (Rodrigues), so that the drawn section axes stay orthonormal where
-    the linear theory's I + hat θ would not.
-    """
-    rot = np.asarray(rot, dtype=float)
-    n = len(rot)
-    if finite:
-        q0, v = rot[:, 0], rot[:, 1:]
-        W = _hat(v)
-        R = (q0**2 - np.einsum("ni,ni->n", v, v))[:, None, None] * np.eye(3)
-        R = R + 2 * np.einsum("ni,nj->nij", v, v) + 2 * q0[:, None, None] * W
-        return R / np.einsum("ni,ni->n", rot, rot)[:, None, None]
-    angle = np.linalg.norm(rot, axis=1)
-    W = _hat(rot)
-    small = angle < 1e-8
-    a = np.where(small, 1.0, angle)
-    c1 = np.where(small, 1.0 - angle**2 / 6, np.sin(a) / a)
-    c2 = np.where(small, 0.5 - angle**2 / 24, (1 - np.cos(a)) / a**2)
-    return (
-        np.broadcast_to(np.eye(3), (n, 3, 3)) + c1[:, None, None] * W + c2[:, None, None] * (W @ W)
-    )
-
-
-def _hat(v):
-    W = np.zeros((len(v), 3, 3))
-    W[:, 0, 1], W[:, 0, 2], W[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
-    W[:, 1, 0], W[:, 2, 0], W[:, 2, 1] = v[:, 2], -v[:, 1], v[:, 0]
-    return W
+    """Rotation matrices of an (n, 4) array of quaternions (any norm) or an (n, 3) array of
+    rotation vectors (linear kinematics): the exact exponential map, so that the drawn section
+    axes stay orthonormal where the linear theory's I + hat θ would not."""
+    return np_rotation(rot) if finite else np_exp_rotation(rot)

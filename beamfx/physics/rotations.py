@@ -57,17 +57,33 @@ def spatial_rate(q, dq):
 
 
 def np_hat(v):
-    """NumPy :func:`hat`."""
-    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    """NumPy :func:`hat` of one vector (3,) or of many (..., 3) -> (..., 3, 3)."""
+    v = np.asarray(v, dtype=float)
+    W = np.zeros(v.shape + (3,))
+    W[..., 0, 1], W[..., 0, 2], W[..., 1, 2] = -v[..., 2], v[..., 1], -v[..., 0]
+    W[..., 1, 0], W[..., 2, 0], W[..., 2, 1] = v[..., 2], -v[..., 1], v[..., 0]
+    return W
 
 
 def np_rotation(q):
-    """NumPy :func:`rotation` for one quaternion or an array of shape (n, 4)."""
+    """NumPy :func:`rotation` of one quaternion (4,) or of many (..., 4), any norm."""
     q = np.asarray(q, dtype=float)
-    if q.ndim == 2:
-        return np.array([np_rotation(qi) for qi in q])
-    q0, v = q[0], q[1:]
-    return ((q0**2 - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * q0 * np_hat(v)) / (q @ q)
+    q0, v = q[..., 0, None, None], q[..., 1:]
+    vv = np.einsum("...i,...i->...", v, v)[..., None, None]
+    R = (q0**2 - vv) * np.eye(3) + 2 * np.einsum("...i,...j->...ij", v, v) + 2 * q0 * np_hat(v)
+    return R / np.einsum("...i,...i->...", q, q)[..., None, None]
+
+
+def np_exp_rotation(theta):
+    """Rotation exp(hat θ) (Rodrigues) of one rotation vector (3,) or of many (..., 3)."""
+    theta = np.asarray(theta, dtype=float)
+    angle = np.linalg.norm(theta, axis=-1)[..., None, None]
+    W = np_hat(theta)
+    small = angle < 1e-8
+    a = np.where(small, 1.0, angle)
+    c1 = np.where(small, 1.0 - angle**2 / 6, np.sin(a) / a)
+    c2 = np.where(small, 0.5 - angle**2 / 24, (1 - np.cos(a)) / a**2)
+    return np.eye(3) + c1 * W + c2 * (W @ W)
 
 
 def np_quaternion(axis, angle):
