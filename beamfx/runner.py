@@ -52,11 +52,11 @@ def run_scene(path=None, out_dir=None, log=None):
     log(f"beamfx: {path} -> {out}/")
     model = BeamModel(scene.model, comm, extra_points=scene.probes.values())
     log(
-        f"model: {len(scene.model.beams)} beam(s), {len(model.mesh.cell_beam)} local elements, degree "
+        f"model: {len(scene.model.beams)} beam(s), {model.mesh.mesh.topology.index_map(1).size_global} elements, degree "
         f"{model.degree}, {model.unknowns()} unknowns, {'finite' if model.kin.finite else 'linear'} kinematics"
     )
     pvd, xdmf = PvdSeries(out / "deformed.pvd"), XdmfSeries(out / "deformed.xdmf")
-    probes_path = {}
+    latest = {}  # probe values of the last accepted step, rotations tracked along the path
 
     def on_step(step):
         fields = nodal_fields(model)
@@ -65,13 +65,12 @@ def run_scene(path=None, out_dir=None, log=None):
         pvd.add(step.load_factor, vtu)
         xdmf.add(step.load_factor, fields)
         values = evaluate_points(model, list(scene.probes.values()))
-        probes_path[step.load_factor] = track_rotations(probes_path.get("_last"), values)
-        probes_path["_last"] = probes_path[step.load_factor]
+        latest["probes"] = track_rotations(latest.get("probes"), values)
 
     result = solve_static(
         model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
     )
-    final = probes_path["_last"]
+    final = latest["probes"]
     results = {
         "scene": str(path),
         "analysis": scene.analysis,

@@ -91,7 +91,18 @@ def write_vtu(path, fields, comm=MPI.COMM_WORLD):
     _write_atomic(path, root)
 
 
-class PvdSeries:
+class _Series:
+    """A file listing one entry per step, rewritten whole (atomically) on rank 0 after each."""
+
+    def __init__(self, path, comm=MPI.COMM_WORLD):
+        self.path, self.comm, self.entries = os.fspath(path), comm, []
+
+    def _append(self, entry):
+        self.entries.append(entry)
+        _write_atomic(self.path, self._tree())
+
+
+class PvdSeries(_Series):
     """ParaView collection of .vtu files, one per time (or load factor), rewritten on each add.
 
     Args:
@@ -99,20 +110,18 @@ class PvdSeries:
         comm: the communicator whose rank 0 writes.
     """
 
-    def __init__(self, path, comm=MPI.COMM_WORLD):
-        self.path, self.comm, self.entries = os.fspath(path), comm, []
-
     def add(self, time, vtu_path):
         """Append a written ``vtu_path`` at ``time`` and rewrite the .pvd (rank 0)."""
-        if self.comm.rank != 0:
-            return
-        rel = os.path.relpath(os.fspath(vtu_path), os.path.dirname(os.path.abspath(self.path)))
-        self.entries.append((float(time), rel))
+        if self.comm.rank == 0:
+            folder = os.path.dirname(os.path.abspath(self.path))
+            self._append((float(time), os.path.relpath(os.fspath(vtu_path), folder)))
+
+    def _tree(self):
         root = ET.Element("VTKFile", type="Collection", version="1.0", byte_order="LittleEndian")
         coll = ET.SubElement(root, "Collection")
         for t, f in self.entries:
             ET.SubElement(coll, "DataSet", timestep=repr(t), group="", part="0", file=f)
-        _write_atomic(self.path, root)
+        return root
 
 
 def _xdmf_item(parent, a, number_type):
@@ -124,7 +133,7 @@ def _xdmf_item(parent, a, number_type):
     return e
 
 
-class XdmfSeries:
+class XdmfSeries(_Series):
     """XDMF 3 temporal collection of the polyline with all data inline (``Format="XML"``).
 
     The whole file is rewritten (atomically) after every step, so it is valid after each one;
@@ -135,15 +144,12 @@ class XdmfSeries:
         comm: the communicator whose rank 0 writes.
     """
 
-    def __init__(self, path, comm=MPI.COMM_WORLD):
-        self.path, self.comm, self.grids = os.fspath(path), comm, []
-
     def add(self, time, fields):
         """Append the fields of one step at ``time`` and rewrite the file (rank 0)."""
         if self.comm.rank != 0:
             return
         cells = np.asarray(fields["cells"], dtype=np.int64)
-        grid = ET.Element("Grid", Name=f"step_{len(self.grids)}", GridType="Uniform")
+        grid = ET.Element("Grid", Name=f"step_{len(self.entries)}", GridType="Uniform")
         ET.SubElement(grid, "Time", Value=repr(float(time)))
         topo = ET.SubElement(
             grid,
@@ -159,11 +165,13 @@ class XdmfSeries:
             kind = "Vector" if a.ndim == 2 and a.shape[1] == 3 else "Scalar"
             att = ET.SubElement(grid, "Attribute", Name=name, AttributeType=kind, Center="Node")
             _xdmf_item(att, a, "Int" if a.dtype.kind in "iu" else "Float")
-        self.grids.append(grid)
+        self._append(grid)
+
+    def _tree(self):
         root = ET.Element("Xdmf", Version="3.0")
         domain = ET.SubElement(root, "Domain")
         series = ET.SubElement(
             domain, "Grid", Name="beam", GridType="Collection", CollectionType="Temporal"
         )
-        series.extend(self.grids)
-        _write_atomic(self.path, root)
+        series.extend(self.entries)
+        return root

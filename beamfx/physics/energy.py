@@ -43,4 +43,6 @@ def spring_energy(u, k):
 
 def load_work(kin, rot, v_u, v_rot, force, moment, follower):
     """Virtual work of a force and a moment, both dead or both follower."""
-    return force_work(kin, rot, v_u, force, follower) + moment_work(kin, rot, v_rot, moment, follower)
+    return force_work(kin, rot, v_u, force, follower) + moment_work(
+        kin, rot, v_rot, moment, follower
+    )
