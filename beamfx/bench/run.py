@@ -198,7 +198,8 @@ def markdown(results):
                 )
                 + "; published: "
                 + ", ".join(
-                    f"{k}: {v.get('dofs', '?')} dofs" for k, v in r["extra"]["problem_size"].items()
+                    f"{k}: " + (f"{v['dofs']} dofs" if "dofs" in v else f"{v['states']} states")
+                    for k, v in r["extra"]["problem_size"].items()
                 ),
             ]
         if "inside_published_spread" in r:
