@@ -31,7 +31,9 @@ def tip(elements, degree, follower=False):
     from dataclasses import replace
 
     beams = (replace(model_spec.beams[0], elements=elements, degree=degree),)
-    loads = tuple(replace(p, follower=follower) for p in model_spec.point_loads)
+    loads = tuple(
+        replace(p, kind="follower" if follower else "dead") for p in model_spec.point_loads
+    )
     model = BeamModel(
         replace(model_spec, beams=beams, point_loads=loads), extra_points=["bend:end"]
     )

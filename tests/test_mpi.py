@@ -18,7 +18,8 @@ def test_bend45_probes_match_serial(follower):
     from dataclasses import replace
 
     spec = load_scene(default_scene_path()).model
-    spec = replace(spec, point_loads=tuple(replace(p, follower=follower) for p in spec.point_loads))
+    kind = "follower" if follower else "dead"
+    spec = replace(spec, point_loads=tuple(replace(p, kind=kind) for p in spec.point_loads))
     out = {}
     for comm in (MPI.COMM_SELF, MPI.COMM_WORLD):
         model = BeamModel(spec, comm, extra_points=["bend:end", "bend:0.5"])

@@ -19,36 +19,172 @@ def rigid_mode_rows(xyz, dofs, centre):
     return rows
 
 
-def free_rigid_modes(model):
-    """Number of rigid-body motions that supports and springs leave free.
+def _size(model):
+    ends = np.vstack([b.curve.points([0.0, b.curve.length]) for b in model.beams])
+    return max(float(np.ptp(ends)), 1.0)
 
-    Joints are rigid, so the only zero-energy motions of a beam model are rigid-body motions;
-    they are free when the six mode vectors, restricted to the constrained dofs, lose rank.
+
+def closest_arc_length(curve, x, samples=400):
+    """Arc length of the point of ``curve`` closest to ``x``, and the distance."""
+    s = np.linspace(0.0, curve.length, samples + 1)
+    i = int(np.argmin(np.linalg.norm(curve.points(s) - x, axis=1)))
+    a, b = s[max(i - 1, 0)], s[min(i + 1, samples)]
+    for _ in range(80):  # golden-section search in the bracketing interval
+        c, d = b - 0.618 * (b - a), a + 0.618 * (b - a)
+        fc, fd = (np.linalg.norm(curve.points([t])[0] - x) for t in (c, d))
+        a, b = (a, d) if fc < fd else (c, b)
+    t = (a + b) / 2
+    return t, float(np.linalg.norm(curve.points([t])[0] - x))
+
+
+def joint_breaks(model, rtol=1e-8):
+    """(beam index, arc length) where the end of another beam meets a beam inside its span
+    (a T-joint): the mesh needs a vertex there for the joint to exist."""
+    tol = rtol * _size(model)
+    out = []
+    for i, a in enumerate(model.beams):
+        for x in a.curve.points([0.0, a.curve.length]):
+            for j, b in enumerate(model.beams):
+                if j != i:
+                    s, dist = closest_arc_length(b.curve, x)
+                    if dist < tol < s < b.curve.length - tol:
+                        out.append((j, s))
+    return out
+
+
+def connected_beams(model, rtol=1e-8):
+    """Groups of beam indices joined by shared points (ends, T-joints), as sorted lists."""
+    tol = rtol * _size(model)
+    group = list(range(len(model.beams)))
+
+    def root(i):
+        while group[i] != i:
+            i = group[i]
+        return i
+
+    for i, a in enumerate(model.beams):
+        for x in a.curve.points([0.0, a.curve.length]):
+            for j, b in enumerate(model.beams):
+                if j != i and closest_arc_length(b.curve, x)[1] < tol:
+                    group[root(i)] = root(j)
+    groups = {}
+    for i in range(len(model.beams)):
+        groups.setdefault(root(i), []).append(i)
+    return sorted(groups.values())
+
+
+def section_axes_at(beam, s):
+    """Reference section frame Λ0 (columns: tangent, e2, e3) of ``beam`` at arc length s, in
+    NumPy, by the convention of :func:`beamfx.physics.kinematics.section_frame`."""
+    L = beam.curve.length
+    h = 1e-6 * L
+    a, b = max(s - h, 0.0), min(s + h, L)
+    t = np.diff(beam.curve.points([a, b]), axis=0)[0]
+    t /= np.linalg.norm(t)
+    ref = beam.orientation
+    if ref is None:
+        ref = (1.0, 0.0, 0.0) if abs(t[2]) > 1 - 1e-8 else (0.0, 0.0, 1.0)
+    e3 = np.asarray(ref, float) - np.dot(ref, t) * t
+    e3 /= np.linalg.norm(e3)
+    e2 = np.cross(e3, t)
+    c, sn = np.cos(np.deg2rad(beam.twist_deg)), np.sin(np.deg2rad(beam.twist_deg))
+    e2, e3 = c * e2 + sn * e3, -sn * e2 + c * e3
+    return np.column_stack([t, e2, e3])
+
+
+#: dofs that the planar model does not have, per plane
+OUT_OF_PLANE = {"xy": ("uz", "rx", "ry"), "yz": ("ux", "ry", "rz"), "xz": ("uy", "rx", "rz")}
+
+
+def _constraint_rows(model, beams, centre, size):
+    """Rows of the rigid-body modes restricted to the constrained dofs on ``beams``."""
+    rows = []
+
+    def add(at, dofs, frame=None):
+        b, _, x = resolve_point(model, at)
+        if b not in beams:
+            return
+        r = rigid_mode_rows((x - centre) / size + centre, DOF_NAMES, centre)
+        r = np.array(r)
+        if frame is not None:  # local axes: combine the global rows with Λ0
+            r = np.vstack([frame.T @ r[:3], frame.T @ r[3:]])
+        rows.extend(r[[DOF_NAMES.index(d) for d in dofs]])
+
+    for sup in model.supports:
+        frame = None
+        if sup.axes == "local":
+            b, s, _ = resolve_point(model, sup.at)
+            frame = section_axes_at(model.beams[b], s)
+        add(sup.at, sup.fix, frame)
+    for sp in model.springs:
+        k = np.r_[sp.stiffness, sp.rotational]
+        add(sp.at, [DOF_NAMES[i] for i in range(6) if k[i] > 0])
+    plane = model.kinematics.plane
+    if plane:  # the planar model has no out-of-plane motion
+        add(f"{model.beams[beams[0]].name}:start", OUT_OF_PLANE[plane])
+    return rows
+
+
+def free_rigid_modes(model):
+    """Number of rigid-body motions that supports and springs leave free, summed over the
+    groups of connected beams.
+
+    Joints are rigid, so the only zero-energy motions of a beam model are rigid-body motions of
+    each connected group; they are free when the six mode vectors, restricted to the
+    constrained dofs of the group, lose rank.
     """
-    points = [(resolve_point(model, s.at)[2], s.fix) for s in model.supports]
-    points += [
-        (resolve_point(model, s.at)[2], [DOF_NAMES[i] for i in range(3) if s.stiffness[i] > 0])
-        for s in model.springs
-    ]
-    if not points:
-        return 6
-    centre = np.mean([p for p, _ in points], axis=0)
-    size = max(1.0, max(np.linalg.norm(p - centre) for p, _ in points))
-    rows = [
-        r for p, dofs in points for r in rigid_mode_rows((p - centre) / size + centre, dofs, centre)
-    ]
-    if not rows:
-        return 6
-    sv = np.linalg.svd(np.array(rows), compute_uv=False)
-    return 6 - int(np.sum(sv > 1e-9 * sv[0]))
+    return sum(n for _, n in free_modes_by_group(model))
+
+
+def free_modes_by_group(model):
+    """[(beam names of a connected group, free rigid-body motions of it)]."""
+    out = []
+    for beams in connected_beams(model):
+        ends = np.vstack(
+            [model.beams[b].curve.points([0.0, model.beams[b].curve.length]) for b in beams]
+        )
+        centre = ends.mean(axis=0)
+        size = max(1.0, float(np.max(np.linalg.norm(ends - centre, axis=1))))
+        rows = _constraint_rows(model, beams, centre, size)
+        rank = 0
+        if rows:
+            sv = np.linalg.svd(np.array(rows), compute_uv=False)
+            rank = int(np.sum(sv > 1e-9 * sv[0]))
+        out.append(([model.beams[b].name for b in beams], 6 - rank))
+    return out
 
 
 def check_supported(model):
     """Raise ValueError if supports and springs leave rigid-body motion free."""
-    n = free_rigid_modes(model)
-    if n:
+    bad = [(names, n) for names, n in free_modes_by_group(model) if n]
+    if bad:
         given = [f"{s.at}: {list(s.fix)}" for s in model.supports]
+        groups = "; ".join(f"{n} rigid-body motion(s) free on beams {names}" for names, n in bad)
         raise ValueError(
-            f"supports leave {n} rigid-body motion(s) free; supports given: {given or 'none'}. "
-            f"Fix more dofs (allowed: {list(DOF_NAMES)}) or add springs."
+            f"supports leave {groups}; supports given: "
+            f"{given or 'none'}. Fix more dofs (allowed: {list(DOF_NAMES)}) or add springs; "
+            "beams that share no point are separate bodies and each needs its own supports."
         )
+
+
+def check_planar(model):
+    """Raise ValueError if a planar model's geometry or loads leave its plane."""
+    from ..physics.kinematics import PLANES
+
+    plane = model.kinematics.plane
+    if not plane:
+        return
+    n = PLANES[plane][2]
+    tol = 1e-9 * _size(model)
+    for b in model.beams:
+        x = b.curve.points(np.linspace(0.0, b.curve.length, 101))
+        if np.ptp(x[:, n]) > tol:
+            raise ValueError(f"planar model ({plane}): beam {b.name!r} leaves the plane")
+    for ld in (*model.point_loads, *model.distributed_loads):
+        if ld.force[n] or any(ld.moment[i] for i in range(3) if i != n):
+            raise ValueError(
+                f"planar model ({plane}): a load has out-of-plane components "
+                f"(force {list(ld.force)}, moment {list(ld.moment)})"
+            )
+    if model.gravity[n]:
+        raise ValueError(f"planar model ({plane}): gravity {list(model.gravity)} leaves the plane")

@@ -58,9 +58,13 @@ def point_displacement_dofs(model, at):
         )
     verts = model.mesh.point_tags.find(model.mesh.points[at][0])
     owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
+    components = {name: comp for name, sub, comp in model.kin.dofs() if sub == 0}
     out = []
-    for i in range(3):
-        d = fem.locate_dofs_topological(model.W.sub(0).sub(i), 0, verts)
+    for name in DOF_NAMES[:3]:
+        if name not in components:  # out of the planar model's plane: always zero
+            out.append(np.empty(0, np.int32))
+            continue
+        d = fem.locate_dofs_topological(model.W.sub(0).sub(components[name]), 0, verts)
         out.append(d[d < owned][:1])
     return out
 
@@ -145,7 +149,10 @@ def trace_path(
             )
         comp = DOF_NAMES.index(comp)
 
-    follower = any(ld.follower for ld in (*spec.point_loads, *spec.distributed_loads))
+    # the load vector depends on the state for follower and semitangential loads, and for
+    # fixed moments under finite rotations (their work is M·δθ with δθ a function of q)
+    loads = (*spec.point_loads, *spec.distributed_loads)
+    follower = any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)
     base = settings or ArcLengthSettings()
     settings = replace(base, follower=base.follower or follower)
     c0 = compile_seconds[0]

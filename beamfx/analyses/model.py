@@ -10,8 +10,9 @@ from mpi4py import MPI
 
 from ..geometry import BeamSpec, build_mesh
 from ..physics import energy
-from ..physics.kinematics import section_frame, strains, tangent
+from ..physics.kinematics import displacement, rotation_vector, section_frame, strains, tangent
 from ..physics.rotations import np_quaternion
+from .checks import joint_breaks
 from .spec import DOF_NAMES, resolve_point
 
 
@@ -24,21 +25,30 @@ def default_reference(tangents):
     return np.where(along_z[:, None], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
 
 
-def _dg0(mesh, values):
-    """A DG0 Function (scalar or vector) with the given per-local-cell values."""
+def _cell_field(mesh, degree, values):
+    """A DG ``degree`` Function with values (n_cells, points, size) at the interpolation points
+    of each local cell (scalar if size is 1, and then values may be (n_cells, points))."""
     from dolfinx import fem
 
     values = np.asarray(values, float)
-    size = 1 if values.ndim == 1 else values.shape[1]
-    V = (
-        fem.FunctionSpace(mesh, ("DG", 0))
-        if size == 1
-        else fem.VectorFunctionSpace(mesh, ("DG", 0), dim=size)
-    )
+    size = 1 if values.ndim == 2 else values.shape[2]
+    cell = mesh.ufl_cell()
+    if size == 1:
+        element = ufl.FiniteElement("DG", cell, degree, variant="equispaced")
+    else:
+        element = ufl.VectorElement("DG", cell, degree, dim=size, variant="equispaced")
+    V = fem.FunctionSpace(mesh, element)
     f = fem.Function(V)
-    dofs = V.dofmap.list.array[: len(values)]  # one (blocked) dof per cell
-    f.x.array.reshape(-1, size)[dofs] = values.reshape(-1, size)
+    n_points = values.shape[1]
+    dofs = V.dofmap.list.array.reshape(-1, n_points)[: len(values)]
+    f.x.array.reshape(-1, size)[dofs.ravel()] = values.reshape(-1, size)
     return f
+
+
+def _dg0(mesh, values):
+    """A DG0 Function (scalar or vector) with the given per-local-cell values."""
+    values = np.asarray(values, float)
+    return _cell_field(mesh, 0, values[:, None])
 
 
 class BeamModel:
@@ -53,13 +63,13 @@ class BeamModel:
         from dolfinx import fem
         from petsc4py import PETSc
 
+        from .checks import check_planar
+
         self.spec, self.kin = model, model.kinematics
-        degrees = {b.degree for b in model.beams}
-        if len(degrees) != 1:
-            raise ValueError(
-                f"all beams must have the same degree in this version, got {sorted(degrees)}"
-            )
-        self.degree = p = degrees.pop()
+        check_planar(model)
+        # one DOLFINx mesh holds one element type: every beam gets the highest degree asked for
+        self.degree = p = max(b.degree for b in model.beams)
+        self.raised_degree = [b.name for b in model.beams if b.degree < p]
 
         # named points: every 'at' of supports, loads, springs and probes becomes a vertex
         ats = [x.at for x in (*model.supports, *model.point_loads, *model.springs)] + list(
@@ -69,6 +79,8 @@ class BeamModel:
         breaks = {i: [] for i in range(len(model.beams))}
         for b, s, _ in self.named.values():
             breaks[b].append(s)
+        for b, s in joint_breaks(model):
+            breaks[b].append(s)
         specs = [
             BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i]))
             for i, b in enumerate(model.beams)
@@ -77,31 +89,27 @@ class BeamModel:
         m = self.mesh.mesh
         self.comm = comm
 
-        # per-cell section data (DG0): stiffnesses, reference vector, twist
+        # section data per cell: stiffness and inertia (DG_p where a section varies, else DG0),
+        # reference vector and twist (DG0)
         beams = model.beams
         cb = self.mesh.cell_beam
-        secs = [
-            b.section.with_limits(not self.kin.shear, not self.kin.stretch, b.curve.length)
-            for b in beams
-        ]
-        stiff = np.array([s.stiffnesses() for s in secs])[cb] if len(cb) else np.empty((0, 6))
+        self.stiffness, self.inertia, raw_max = self._section_fields()
         ref = default_reference(self._cell_tangents())
         for i, b in enumerate(beams):
             if b.orientation is not None:
                 ref[cb == i] = b.orientation
         twist = np.deg2rad([beams[b].twist_deg for b in cb])
-        self.stiffness = _dg0(m, stiff)
         self.reference, self.twist = _dg0(m, ref), _dg0(m, twist)
-        kp = 10 * max(max(s.EA, s.GA_y, s.GA_z) for s in (b.section for b in beams))
-        self.k_penalty = fem.Constant(m, PETSc.ScalarType(kp))
+        self.k_penalty = fem.Constant(m, PETSc.ScalarType(10 * raw_max))
 
         # unknowns: displacement P_k (3) and rotation P_k (quaternion 4, or rotation vector 3)
         cell = m.ufl_cell()
-        U = ufl.VectorElement("Lagrange", cell, p, dim=3)
+        U = ufl.VectorElement("Lagrange", cell, p, dim=self.kin.displacement_size)
         Q = ufl.VectorElement("Lagrange", cell, p, dim=self.kin.rotation_size)
         self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q]))
         self.w = fem.Function(self.W, name="unknowns")
-        self._q0_dofs = self.W.sub(1).sub(0).collapse()[1] if self.kin.finite else []
+        quaternion = self.kin.finite and not self.kin.plane
+        self._q0_dofs = self.W.sub(1).sub(0).collapse()[1] if quaternion else []
         self.reset()
 
         # measures: shear/axial with p Gauss points (exact to 2p-1), the rest with p+1
@@ -118,6 +126,54 @@ class BeamModel:
         self.bcs, self._bc_values = self._build_supports()
 
     # --- set-up ----------------------------------------------------------------------------
+
+    def _cell_arc_lengths(self, X):
+        """Arc length of the reference points ``X`` (in [0, 1]) of each local cell."""
+        m, spans = self.mesh.mesh, self.mesh.cell_span
+        n = len(spans)
+        nodes = m.geometry.dofmap.array.reshape(-1, self.degree + 1)[:n]
+        x0 = m.geometry.x[nodes[:, 0]]
+        flipped = np.zeros(n, bool)  # DOLFINx may reverse a cell: its vertex 0 is then at s_b
+        for i, b in enumerate(self.spec.beams):
+            sel = self.mesh.cell_beam == i
+            if np.any(sel):
+                at_a = np.linalg.norm(x0[sel] - b.curve.points(spans[sel, 0]), axis=1)
+                at_b = np.linalg.norm(x0[sel] - b.curve.points(spans[sel, 1]), axis=1)
+                flipped[sel] = at_b < at_a
+        s0 = np.where(flipped, spans[:, 1], spans[:, 0])
+        s1 = np.where(flipped, spans[:, 0], spans[:, 1])
+        return s0[:, None] + np.asarray(X)[None, :] * (s1 - s0)[:, None]
+
+    def _section_fields(self):
+        """Stiffness (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertia (rho_A, rho_I) fields, the
+        shear-rigid/inextensible limits applied; and the largest EA or GA before the limits."""
+        kin, beams, cb = self.kin, self.spec.beams, self.mesh.cell_beam
+        varies = any(b.section.varies for b in beams)
+        q = self.degree if varies else 0
+        X = np.r_[0.0, 1.0, np.arange(1, q) / q] if q else np.array([0.5])  # basix DG order
+        S = self._cell_arc_lengths(X)
+        stiff = np.zeros((len(cb), len(X), 6))
+        mass = np.zeros((len(cb), len(X), 4))
+        raw_max = 0.0
+        for i, b in enumerate(beams):
+            sel = cb == i
+            samples = b.section.along(S[sel].ravel()) if np.any(sel) else b.section.along([0.0])
+            raw_max = max(raw_max, max(max(x.EA, x.GA_y, x.GA_z) for x in samples))
+            limited = {}
+            for x in samples:
+                if id(x) not in limited:
+                    limited[id(x)] = x.with_limits(not kin.shear, not kin.stretch, b.curve.length)
+            stiff[sel] = np.array([limited[id(x)].stiffnesses() for x in samples]).reshape(
+                -1, len(X), 6
+            )[: np.count_nonzero(sel)]
+            mass[sel] = np.array([x.inertias() for x in samples]).reshape(-1, len(X), 4)[
+                : np.count_nonzero(sel)
+            ]
+        if np.any(stiff <= 0):
+            raise ValueError("a section stiffness is not positive somewhere along a beam")
+        raw_max = self.comm.allreduce(raw_max, op=MPI.MAX)
+        m = self.mesh.mesh
+        return _cell_field(m, q, stiff), _cell_field(m, q, mass), raw_max
 
     def _cell_tangents(self):
         m = self.mesh.mesh
@@ -142,45 +198,73 @@ class BeamModel:
             return ufl.dS(domain=m, subdomain_data=self.mesh.point_tags)(tag), "+"
         return ufl.ds(domain=m, subdomain_data=self.mesh.point_tags)(tag), None
 
+    def _at_point(self, at, integrand):
+        """``integrand`` integrated at the named point (restricted there if it is inside)."""
+        dP, side = self.point_measure(at)
+        return (integrand(side) if side else integrand) * dP
+
     def _build_forms(self):
         spec, kin = self.spec, self.kin
         u, rot = ufl.split(self.w)
-        v_u, v_rot = ufl.split(ufl.TestFunction(self.W))
+        u3 = displacement(kin, u)
+        test = ufl.TestFunction(self.W)
+        v_u, v_rot = ufl.split(test)
         Gamma, K = strains(kin, u, rot, self.t0, self.Lam0)
         Pi = energy.strain_energy(Gamma, K, self.C_N, self.C_M, self.dx_shear, self.dx)
-        if kin.finite:
+        if kin.finite and not kin.plane:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, self.dx)
         for sp in spec.springs:
-            dP, side = self.point_measure(sp.at)
-            e = energy.spring_energy(u, [float(k) for k in sp.stiffness])
-            Pi += (e(side) if side else e) * dP
+            k_u, k_r = [float(k) for k in sp.stiffness], [float(k) for k in sp.rotational]
+            if any(k_u):
+                Pi += self._at_point(sp.at, energy.spring_energy(u3, k_u))
+            if any(k_r):
+                Pi += self._at_point(sp.at, energy.rotational_spring_energy(kin, rot, k_r))
+        for sup in spec.supports:
+            if sup.axes == "local":
+                Pi += self._at_point(sup.at, self._local_support_penalty(sup, u3, rot))
 
         def vec(x):
             return ufl.as_vector([float(c) for c in x])
 
         def work_of(load):
             return energy.load_work(
-                kin, rot, v_u, v_rot, vec(load.force), vec(load.moment), load.follower
+                kin, rot, v_u, v_rot, vec(load.force), vec(load.moment), load.kind
             )
 
         work = 0
         for ld in spec.point_loads:
-            dP, side = self.point_measure(ld.at)
-            wk = work_of(ld)
-            work += (wk(side) if side else wk) * dP
+            work += self._at_point(ld.at, work_of(ld))
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
-            wk = work_of(dl)
             on_beam = 1.0 if dl.beam is None else self._beam_indicator(names.index(dl.beam))
-            work += on_beam * wk * self.dx
+            work += on_beam * work_of(dl) * self.dx
         if any(spec.gravity):
-            rho_A = self._dg0_beam_values([b.section.rho_A for b in spec.beams])
-            work += rho_A * ufl.dot(vec(spec.gravity), v_u) * self.dx
+            rho_A = self.inertia[0]
+            work += rho_A * ufl.dot(vec(spec.gravity), displacement(kin, v_u)) * self.dx
         self.Pi = Pi
-        self.F = ufl.derivative(Pi, self.w, ufl.TestFunction(self.W))
+        self.F = ufl.derivative(Pi, self.w, test)
         if work != 0:
             self.F -= self.load_factor * work
         self.J = ufl.derivative(self.F, self.w, ufl.TrialFunction(self.W))
+
+    def _local_support_penalty(self, sup, u3, rot):
+        """Stiff springs on the fixed dofs in the section axes Λ0 at the point (values scaled by
+        the load factor). Stiffness 1e9·(largest EA, GA or GJ, EI)/(shortest element)."""
+        h = self.comm.allreduce(np.min(np.diff(self.mesh.cell_span, axis=1)), op=MPI.MIN)
+        C = self.stiffness
+        k_u = 1e9 * ufl.max_value(ufl.max_value(C[0], C[1]), C[2]) / h
+        k_r = 1e9 * ufl.max_value(ufl.max_value(C[3], C[4]), C[5]) / h
+        local_u = self.Lam0.T * u3
+        local_r = self.Lam0.T * rotation_vector(self.kin, rot)
+        terms = 0
+        for d in sup.fix:
+            i = DOF_NAMES.index(d)
+            if i < 3:
+                value, target, k = local_u[i], self.load_factor * sup.displacement[i], k_u
+            else:
+                value, target, k = local_r[i - 3], self.load_factor * sup.rotation[i - 3], k_r
+            terms += energy.constraint_penalty([value], [target], k)
+        return terms
 
     def _dg0_beam_values(self, per_beam):
         return _dg0(self.mesh.mesh, np.asarray(per_beam, float)[self.mesh.cell_beam])
@@ -199,6 +283,8 @@ class BeamModel:
         m = self.mesh.mesh
         bcs, values = [], []
         for sup in self.spec.supports:
+            if sup.axes == "local":
+                continue  # penalty springs in the forms
             bad = [d for d in sup.fix if d not in DOF_NAMES]
             if bad:
                 raise ValueError(
@@ -216,6 +302,8 @@ class BeamModel:
 
     def _support_targets(self, sup):
         """(subspace, component, value as a function of the load factor) per constrained scalar."""
+        if self.kin.plane:
+            return self._planar_support_targets(sup)
         fixed_u = [DOF_NAMES.index(d) for d in sup.fix if d.startswith("u")]
         fixed_r = [DOF_NAMES.index(d) - 3 for d in sup.fix if d.startswith("r")]
         d = np.asarray(sup.displacement, float)
@@ -234,6 +322,22 @@ class BeamModel:
                 f"support at {sup.at!r}: a prescribed rotation needs rx, ry and rz fixed"
             )
         return out + [(1, 1 + i, lambda lam: 0.0) for i in fixed_r]  # rotation axis normal to these
+
+    def _planar_support_targets(self, sup):
+        """Planar model: the in-plane dofs; out-of-plane ones do not exist (zero by construction)."""
+        dofs = {name: (sub, comp) for name, sub, comp in self.kin.dofs()}
+        values = np.r_[sup.displacement, sup.rotation]
+        out = []
+        for d in sup.fix:
+            i = DOF_NAMES.index(d)
+            if d in dofs:
+                out.append((*dofs[d], lambda lam, v=values[i]: lam * v))
+            elif values[i]:
+                raise ValueError(
+                    f"support at {sup.at!r}: {d} = {values[i]} leaves the plane "
+                    f"{self.kin.plane} of the planar model"
+                )
+        return out
 
     # --- state -----------------------------------------------------------------------------
 

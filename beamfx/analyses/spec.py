@@ -21,26 +21,42 @@ class Beam:
     twist_deg: float = 0.0
 
 
+AXES = ("global", "local")
+LOAD_KINDS = ("dead", "follower", "semitangential")
+
+
 @dataclass(frozen=True)
 class Support:
-    """Fixed dofs (names from :data:`DOF_NAMES`, global axes) at a point.
+    """Fixed dofs (names from :data:`DOF_NAMES`) at a point.
 
-    ``displacement`` and ``rotation`` (a rotation vector, global axes) are prescribed values,
-    applied with the load factor; zero by default.
+    ``axes`` "global": the names are global axes, and the conditions are exact (Dirichlet).
+    "local": the names are the beam's reference section axes at the point (x the tangent, y
+    and z the section's principal axes); the conditions are then stiff penalty springs
+    (:meth:`BeamModel.penalty`), which leave a relative error of about 1e-9.
+    ``displacement`` and ``rotation`` (a rotation vector) are prescribed values in the same
+    axes, applied with the load factor; zero by default.
     """
 
     at: str
     fix: tuple
     displacement: tuple = (0.0, 0.0, 0.0)
     rotation: tuple = (0.0, 0.0, 0.0)
+    axes: str = "global"
 
 
 @dataclass(frozen=True)
 class PointLoad:
+    """Force and moment at a point; ``kind`` one of :data:`LOAD_KINDS` (see
+    :func:`beamfx.physics.energy.moment_work`)."""
+
     at: str
     force: tuple = (0.0, 0.0, 0.0)
     moment: tuple = (0.0, 0.0, 0.0)
-    follower: bool = False
+    kind: str = "dead"
+
+    @property
+    def follower(self):
+        return self.kind == "follower"
 
 
 @dataclass(frozen=True)
@@ -50,13 +66,21 @@ class DistributedLoad:
     beam: str | None = None
     force: tuple = (0.0, 0.0, 0.0)
     moment: tuple = (0.0, 0.0, 0.0)
-    follower: bool = False
+    kind: str = "dead"
+
+    @property
+    def follower(self):
+        return self.kind == "follower"
 
 
 @dataclass(frozen=True)
 class Spring:
+    """Linear springs to ground: translational (per global axis) and rotational (on the
+    rotation vector, per global axis)."""
+
     at: str
-    stiffness: tuple  # translational spring to ground, per global axis
+    stiffness: tuple = (0.0, 0.0, 0.0)
+    rotational: tuple = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)

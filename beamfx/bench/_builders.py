@@ -23,7 +23,9 @@ def cantilever(
     return Model(
         beams=(beam,),
         supports=(Support("b:start", CLAMP),),
-        point_loads=(PointLoad("b:end", tuple(force), tuple(moment), follower),),
+        point_loads=(
+            PointLoad("b:end", tuple(force), tuple(moment), "follower" if follower else "dead"),
+        ),
         kinematics=kinematics,
     )
 

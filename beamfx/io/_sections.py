@@ -7,7 +7,7 @@ name       size  meaning
 =========  ====  =================================================================
 ``X``      3     reference centre line (the mesh is the reference configuration)
 ``u``      3     displacement (global axes)
-``rot``    4/3   quaternion ``q`` (finite kinematics) or rotation vector ``θ``
+``rot``    4/3   quaternion ``q`` (finite kinematics) or rotation vector ``θ`` (linear)
 ``Lam0``   9     reference section frame Λ0, row-major, columns (t0, e2, e3)
 ``N``      3     section force C_N Γ (section axes)
 ``M``      3     section moment C_M K (section axes)
@@ -24,7 +24,7 @@ import weakref
 import numpy as np
 import ufl
 
-from ..physics.kinematics import strains
+from ..physics.kinematics import displacement, rotation_output, strains
 from ..physics.rotations import np_exp_rotation, np_rotation
 from ..solvers.forms import JIT_PARAMS
 
@@ -32,7 +32,7 @@ _compiled = weakref.WeakKeyDictionary()  # model -> {points key: (Expression, la
 
 
 def _layout(kin):
-    sizes = {"X": 3, "u": 3, "rot": kin.rotation_size, "Lam0": 9, "N": 3, "M": 3}
+    sizes = {"X": 3, "u": 3, "rot": kin.output_rotation_size, "Lam0": 9, "N": 3, "M": 3}
     layout, start = {}, 0
     for name, n in sizes.items():
         layout[name] = slice(start, start + n)
@@ -46,7 +46,7 @@ def section_expression(model):
     Gamma, K = strains(model.kin, u, rot, model.t0, model.Lam0)
     X = ufl.SpatialCoordinate(model.mesh.mesh)
     N, M = model.C_N * Gamma, model.C_M * K
-    parts = [X, u, rot, model.Lam0, N, M]
+    parts = [X, displacement(model.kin, u), rotation_output(model.kin, rot), model.Lam0, N, M]
     flat = [p[index] for p in parts for index in np.ndindex(p.ufl_shape)]  # row-major
     layout, size = _layout(model.kin)
     assert len(flat) == size  # internal consistency of the table above
@@ -113,7 +113,7 @@ def evaluate(model, points, cells, recover=True):
         for name in ("N", "M"):
             out[name] = np.einsum("pg,cgi->cpi", A, values[:, n:, layout[name]])
     out["Lam0"] = out["Lam0"].reshape(len(cells), n, 3, 3)
-    R = rotation_matrices(model.kin.finite, out["rot"].reshape(-1, model.kin.rotation_size))
+    R = rotation_matrices(model.kin.finite, out["rot"].reshape(-1, model.kin.output_rotation_size))
     out["axes"] = (R @ out["Lam0"].reshape(-1, 3, 3)).reshape(len(cells), n, 3, 3)
     return out
 

@@ -2,7 +2,13 @@
 
 import ufl
 
-from .kinematics import body_virtual_rotation, section_rotation, spatial_virtual_rotation
+from .kinematics import (
+    body_virtual_rotation,
+    displacement,
+    rotation_vector,
+    section_rotation,
+    spatial_virtual_rotation,
+)
 
 
 def strain_energy(Gamma, K, C_N, C_M, dx_shear, dx_bend):
@@ -22,17 +28,23 @@ def quaternion_penalty(q, k_p, dx):
 def force_work(kin, rot, v_u, force, follower):
     """Virtual work of a force (global axes); a follower force is R·force (turns with the section)."""
     f = section_rotation(kin, rot) * force if follower else force
-    return ufl.dot(f, v_u)
+    return ufl.dot(f, displacement(kin, v_u))
 
 
-def moment_work(kin, rot, v_rot, moment, follower):
-    """Virtual work of a moment: M·δθ (fixed in space, global axes) or M0·Rᵀδθ (follower).
+def moment_work(kin, rot, v_rot, moment, kind):
+    """Virtual work of a moment of ``kind``:
 
-    The fixed-axis moment is not conservative for finite 3D rotations; its tangent is
-    unsymmetric and the solvers use LU, which does not mind.
+    * "dead": M·δθ, fixed in space (global axes). Not conservative for finite 3D rotations;
+      its tangent is unsymmetric and the solvers use LU, which does not mind.
+    * "follower": M0·axial(Rᵀδθ), turns with the section (body axes).
+    * "semitangential": M0·δψ, work-conjugate to the rotation vector ψ (Argyris et al. 1979):
+      conservative, with potential −M0·ψ; to first order the moment vector turns by half the
+      rotation, M ≈ M0 + ½ ψ × M0.
     """
-    if follower:
+    if kind == "follower":
         return ufl.dot(moment, body_virtual_rotation(kin, rot, v_rot))
+    if kind == "semitangential":
+        return ufl.derivative(ufl.dot(moment, rotation_vector(kin, rot)), rot, v_rot)
     return ufl.dot(moment, spatial_virtual_rotation(kin, rot, v_rot))
 
 
@@ -41,8 +53,19 @@ def spring_energy(u, k):
     return 0.5 * ufl.dot(u, ufl.diag(ufl.as_vector(k)) * u)
 
 
-def load_work(kin, rot, v_u, v_rot, force, moment, follower):
-    """Virtual work of a force and a moment, both dead or both follower."""
-    return force_work(kin, rot, v_u, force, follower) + moment_work(
-        kin, rot, v_rot, moment, follower
+def rotational_spring_energy(kin, rot, k):
+    """½ ψ·diag(k) ψ of a rotational spring to ground (ψ the rotation vector, global axes)."""
+    return spring_energy(rotation_vector(kin, rot), k)
+
+
+def constraint_penalty(values, targets, k):
+    """½ k Σ (value_i − target_i)²: a stiff spring holding scalar ``values`` at ``targets``."""
+    return 0.5 * k * sum((v - t) ** 2 for v, t in zip(values, targets))
+
+
+def load_work(kin, rot, v_u, v_rot, force, moment, kind):
+    """Virtual work of a force and a moment; ``kind`` as in :func:`moment_work` (a force of
+    kind "semitangential" is dead)."""
+    return force_work(kin, rot, v_u, force, kind == "follower") + moment_work(
+        kin, rot, v_rot, moment, kind
     )

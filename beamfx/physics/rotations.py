@@ -53,6 +53,21 @@ def spatial_rate(q, dq):
     return 2 * (q[0] * dv - dq[0] * v + ufl.cross(v, dv)) / ufl.dot(q, q)
 
 
+def quaternion_rotation_vector(q):
+    r"""Rotation vector ψ = 2 atan2(|v|, q0) v/|v| of a quaternion of any norm.
+
+    Continuous for angles up to 2π along a continuous quaternion field (q0 changes sign at π);
+    near zero the series 2 v/q0 (1 − |v|²/(3 q0²)) replaces the quotient 0/0.
+    """
+    v, q0 = quaternion_vector(q), q[0]
+    vv = ufl.dot(v, v)
+    norm_v = ufl.sqrt(vv + 1e-300)
+    exact = 2 * ufl.atan_2(norm_v, q0) / norm_v * v
+    series = 2 / q0 * (1 - vv / (3 * q0**2)) * v
+    small = ufl.And(ufl.lt(vv, 1e-8 * q0**2), ufl.gt(q0, 0))
+    return ufl.conditional(small, series, exact)
+
+
 # --- NumPy counterparts, for set-up and post-processing --------------------------------------
 
 

@@ -6,7 +6,8 @@ the convention of the reference files.
 """
 
 import math
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,6 +41,16 @@ class Section:
     def stiffnesses(self):
         """The six stiffnesses in the order (EA, GA_y, GA_z, GJ, EI_y, EI_z)."""
         return np.r_[self.C_N, self.C_M]
+
+    def inertias(self):
+        """Mass per length and the section inertia diagonal: (rho_A, rho_I...)."""
+        return np.r_[self.rho_A, self.rho_I]
+
+    varies = False
+
+    def along(self, s):
+        """The section at arc lengths ``s`` (a prismatic beam: the same everywhere)."""
+        return [self] * len(s)
 
     def with_limits(self, shear_rigid=False, inextensible=False, length=1.0, factor=1e8):
         """Section whose shear and/or axial stiffness is raised to a penalty value.
@@ -118,3 +129,24 @@ def tube(E, G, rho, d, d_inner=0.0, shear_factor=None, nu=None):
     nu = E / (2 * G) - 1 if nu is None else nu
     k = shear_factor if shear_factor is not None else cowper_tube(nu, d_inner / d)
     return _from_geometry(E, G, rho, A, I, I, 2 * I, k, k)
+
+
+@dataclass(frozen=True)
+class SectionAlong:
+    """A section whose properties vary along the beam (non-prismatic beams).
+
+    ``make(**values)`` builds the :class:`Section` (e.g. :func:`rectangle` with its material
+    bound); each of ``params`` is a number or a function of the arc length s (from the beam's
+    start). The model samples it at the interpolation points of its section fields.
+    """
+
+    make: Callable
+    params: dict = field(default_factory=dict)
+
+    varies = True
+
+    def along(self, s):
+        def value(v, si):
+            return float(v(si)) if callable(v) else v
+
+        return [self.make(**{k: value(v, si) for k, v in self.params.items()}) for si in s]

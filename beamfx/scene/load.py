@@ -6,17 +6,31 @@ The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, `
 
 import tomllib
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
-from ..analyses.spec import DOF_NAMES, Beam, DistributedLoad, Model, PointLoad, Spring, Support
+import numpy as np
+
+from ..analyses.spec import (
+    AXES,
+    DOF_NAMES,
+    LOAD_KINDS,
+    Beam,
+    DistributedLoad,
+    Model,
+    PointLoad,
+    Spring,
+    Support,
+)
 from ..geometry import curves
 from ..physics import sections
-from ..physics.kinematics import Kinematics
+from ..physics.kinematics import PLANES, Kinematics
+from .expr import compile_expression, table_function
 from .table import SceneError, Table
 
 CURVE_SHAPES = ("line", "arc", "helix", "polyline", "spline", "gmsh")
 SECTION_TYPES = ("rectangle", "circle", "tube", "general")
-ANALYSES = ("static", "linear_static")
+ANALYSES = ("static", "linear_static", "arclength")
 FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
 
 
@@ -31,6 +45,7 @@ class Scene:
     probes: dict = field(default_factory=dict)  # name -> point ("beam:end")
     output_dir: str = "results"
     solver_options: dict = field(default_factory=dict)
+    continuation: dict = field(default_factory=dict)  # arc-length settings ([analysis])
 
 
 def _curve(t, base):
@@ -79,52 +94,81 @@ def _curve(t, base):
     return c
 
 
-def _section(t, mat):
+def _along(t, key, length, default=..., positive=True):
+    """A section value: a number, an expression of the arc length ``s`` (and the beam length
+    ``L``), or a table ``{ s = [...], values = [...] }``; checked positive along the beam."""
+    if not t.has(key) and default is not ...:
+        t.get(key, float, default)
+        return default
+    raw = t.data.get(key)
+    if isinstance(raw, (str, dict)):
+        t.used.add(key)
+        try:
+            if isinstance(raw, str):
+                f = compile_expression(raw, "s", {"L": length})
+            else:
+                sub = Table(raw, t.path + "." + key, t.file)
+                f = table_function(sub.get("s", list), sub.get("values", list))
+                sub.done()
+            values = f(np.linspace(0.0, length, 201))
+        except (ValueError, TypeError, ZeroDivisionError, FloatingPointError) as e:
+            t.fail(
+                key,
+                f"{e} (write a number, an expression of s and L, or {{ s = [...], values = [...] }})",
+            )
+        if positive and not np.all(values > 0):
+            t.fail(
+                key,
+                f"must be positive along the whole beam; its smallest value is {values.min():g}",
+            )
+        return f
+    return t.get(key, float, default, positive=positive)
+
+
+def _section(t, mat, length):
+    """A Section, or a SectionAlong if a value varies along the beam."""
     kind = t.get("type", str, choices=SECTION_TYPES)
     k = t.get("shear_factor", float, None, positive=True)
+    along = partial(_along, t, length=length)
     if kind == "general":
-        vals = {
-            key: t.get(key, float, positive=True)
-            for key in ("EA", "GA_y", "GA_z", "GJ", "EI_y", "EI_z")
-        }
-        rho_A = t.get("rho_A", float, 0.0)
+        params = {key: along(key) for key in ("EA", "GA_y", "GA_z", "GJ", "EI_y", "EI_z")}
+        params["rho_A"] = along("rho_A", default=0.0, positive=False)
         rho_I = t.get("rho_I", "vec3", (0.0, 0.0, 0.0))
-        t.done()
-        return sections.Section(**vals, rho_A=rho_A, rho_I=rho_I)
-    if mat is None:
-        t.fail("type", "a geometric section needs the [material] table (E, nu, rho)")
-    E, G, rho, nu = mat
-    if kind == "rectangle":
-        torsion = t.get("torsion", (str, float, int), "saint-venant")
-        if (
-            isinstance(torsion, bool)
-            or (not isinstance(torsion, str) and torsion <= 0)
-            or (isinstance(torsion, str) and torsion not in ("saint-venant", "thin-strip"))
-        ):
-            t.fail(
-                "torsion",
-                f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J",
-            )
-        s = sections.rectangle(
-            E,
-            G,
-            rho,
-            t.get("h", float, positive=True),
-            t.get("w", float, positive=True),
-            torsion,
-            k,
-            nu,
-        )
-    elif kind == "circle":
-        s = sections.tube(E, G, rho, t.get("d", float, positive=True), 0.0, k, nu)
+
+        def make(rho_I=rho_I, **values):
+            return sections.Section(**values, rho_I=rho_I)
+
     else:
-        d = t.get("d", float, positive=True)
-        di = t.get("d_inner", float)
-        if not 0 <= di < d:
-            t.fail("d_inner", f"must satisfy 0 <= d_inner < d = {d}")
-        s = sections.tube(E, G, rho, d, di, k, nu)
+        if mat is None:
+            t.fail("type", "a geometric section needs the [material] table (E, nu, rho)")
+        E, G, rho, nu = mat
+        if kind == "rectangle":
+            torsion = t.get("torsion", (str, float, int), "saint-venant")
+            if (
+                isinstance(torsion, bool)
+                or (not isinstance(torsion, str) and torsion <= 0)
+                or (isinstance(torsion, str) and torsion not in ("saint-venant", "thin-strip"))
+            ):
+                t.fail(
+                    "torsion",
+                    f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J",
+                )
+            params = {"h": along("h"), "w": along("w")}
+            make = partial(sections.rectangle, E, G, rho, torsion=torsion, shear_factor=k, nu=nu)
+        elif kind == "circle":
+            params = {"d": along("d")}
+            make = partial(sections.tube, E, G, rho, d_inner=0.0, shear_factor=k, nu=nu)
+        else:
+            params = {"d": along("d"), "d_inner": along("d_inner", positive=False)}
+            make = partial(sections.tube, E, G, rho, shear_factor=k, nu=nu)
+            s = np.linspace(0.0, length, 201)
+            d, di = (p(s) if callable(p) else np.full_like(s, p) for p in params.values())
+            if not np.all((0 <= di) & (di < d)):
+                t.fail("d_inner", "must satisfy 0 <= d_inner < d along the whole beam")
     t.done()
-    return s
+    if any(callable(v) for v in params.values()):
+        return sections.SectionAlong(make, params)
+    return make(**params)
 
 
 def _material(t):
@@ -165,7 +209,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         if ":" in name or name in [b.name for b in beams]:
             t.fail("name", f"{name!r} must be unique and contain no ':'")
         curve = _curve(t.table("curve"), base)
-        section = _section(t.table("section"), mat)
+        section = _section(t.table("section"), mat, curve.length)
         beams.append(
             Beam(
                 name,
@@ -180,11 +224,6 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         t.done()
     if not beams:
         top.fail("beams", "a scene needs at least one [[beams]] table")
-    if len({b.degree for b in beams}) > 1:
-        top.fail(
-            "beams",
-            f"all beams must have the same degree in this version, got {[b.degree for b in beams]}",
-        )
     for i, b in enumerate(beams):
         _check_orientation(b, f"{file}: beams[{i}].orientation")
 
@@ -195,6 +234,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             _fix(t),
             t.get("displacement", "vec3", (0.0,) * 3),
             t.get("rotation", "vec3", (0.0,) * 3),
+            t.get("axes", str, "global", choices=AXES),
         )
         free = [
             DOF_NAMES[i] for i in range(3) if sup.displacement[i] and DOF_NAMES[i] not in sup.fix
@@ -213,14 +253,14 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             gravity = t.get("gravity", "vec3")
             t.done()
             continue
-        kind = t.get("kind", str, "dead", choices=("dead", "follower"))
+        kind = t.get("kind", str, "dead", choices=LOAD_KINDS)
         if t.has("at"):
             point_loads.append(
                 PointLoad(
                     t.get("at", str),
                     t.get("force", "vec3", (0.0,) * 3),
                     t.get("moment", "vec3", (0.0,) * 3),
-                    kind == "follower",
+                    kind,
                 )
             )
         else:
@@ -229,7 +269,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
                     t.get("beam", str, None),
                     t.get("force_per_length", "vec3", (0.0,) * 3),
                     t.get("moment_per_length", "vec3", (0.0,) * 3),
-                    kind == "follower",
+                    kind,
                 )
             )
         t.done(
@@ -237,7 +277,14 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         )
     springs = []
     for t in top.tables("springs"):
-        springs.append(Spring(t.get("at", str), t.get("stiffness", "vec3")))
+        sp = Spring(
+            t.get("at", str),
+            t.get("stiffness", "vec3", (0.0,) * 3),
+            t.get("rotational", "vec3", (0.0,) * 3),
+        )
+        if min(*sp.stiffness, *sp.rotational) < 0 or not any((*sp.stiffness, *sp.rotational)):
+            t.fail("stiffness", "give non-negative 'stiffness' and/or 'rotational', not all zero")
+        springs.append(sp)
         t.done()
 
     mt = top.table("model", {})
@@ -245,14 +292,16 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
         shear=mt.get("shear", bool, True),
         stretch=mt.get("stretch", bool, True),
+        plane=mt.get("plane", str, None, choices=tuple(PLANES)),
     )
     mt.done()
     at = top.table("analysis", {})
     analysis = at.get("type", str, "static", choices=ANALYSES)
     steps = at.get("steps", int, 10, positive=True)
+    continuation = _continuation(at) if analysis == "arclength" else {}
     at.done()
     if analysis == "linear_static":
-        kin = Kinematics(False, kin.shear, kin.stretch)
+        kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
 
     probes = {}
     for t in top.tables("probes"):
@@ -277,7 +326,49 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         kin,
     )
     _check_points(model, probes, file)
-    return Scene(file, model, analysis, steps, probes, out_dir, dict(solver))
+    _check_model(model, file)
+    return Scene(file, model, analysis, steps, probes, out_dir, dict(solver), continuation)
+
+
+def _continuation(t):
+    """Arc-length settings of ``[analysis]`` (type = "arclength")."""
+    out = {
+        "control_point": t.get("control_point", str, None),
+        "max_steps": t.get("max_steps", int, 200, positive=True),
+        "target_load_factor": t.get("target_load_factor", float, None),
+        "arc_length": t.get("arc_length", float, None, positive=True),
+        "method": t.get("method", str, "crisfield", choices=("crisfield", "riks")),
+    }
+    if t.has("displacement_limit"):
+        lim = t.get("displacement_limit", list)
+        if len(lim) != 2 or lim[0] not in DOF_NAMES[:3] or isinstance(lim[1], (str, bool)):
+            t.fail(
+                "displacement_limit",
+                f"write [component, value], component in {list(DOF_NAMES[:3])}",
+            )
+        out["displacement_limit"] = (lim[0], float(lim[1]))
+    if out["target_load_factor"] is None and "displacement_limit" not in out:
+        t.fail(
+            "type", "arclength needs target_load_factor or displacement_limit to know where to stop"
+        )
+    return out
+
+
+def _check_model(model, file):
+    """Checks that need the whole model: the planar model's plane, prescribed rotations."""
+    from ..analyses.checks import check_planar
+
+    try:
+        check_planar(model)
+    except ValueError as e:
+        raise SceneError(f"{file}: model.plane: {e}") from None
+    for i, s in enumerate(model.supports):
+        kin = model.kinematics
+        local_rotation = s.axes == "local" and any(s.rotation)
+        if local_rotation and kin.finite and not kin.plane and not {"rx", "ry", "rz"} <= set(s.fix):
+            raise SceneError(
+                f"{file}: supports[{i}].rotation: a prescribed rotation needs rx, ry and rz in fix"
+            )
 
 
 def _check_points(model, probes, file):
