@@ -133,8 +133,9 @@ def _propped(direction, axes):
     is held (in local axes that is uy); a distributed load pushes along that normal."""
     d = np.asarray(direction, float) / np.linalg.norm(direction)
     normal = np.cross([0, 0, 1], d)
-    fix = '["uy"]' if axes == "local" else '["uy"]'
-    return f"""{STEEL}
+    fix = '["uy"]'  # local y is the in-plane normal; global y for the x-aligned beam
+    return (
+        f"""{STEEL}
 [[beams]]
 name = "b"
 curve = {{ shape = "line", start = [0, 0, 0], end = {list(d)} }}
@@ -154,7 +155,10 @@ axes = "{axes}"
 [[loads]]
 beam = "b"
 force_per_length = {list(1e4 * normal)}
-""", d, normal
+""",
+        d,
+        normal,
+    )
 
 
 def test_support_in_local_axes_is_the_rotated_global_one():
@@ -195,7 +199,9 @@ moment = [0, 1e3, 0]
     assert abs(vf["a:end"]["angle"] - vp["a:end"]["angle"]) < 1e-8
     assert vf["a:end"]["angle"] > 0.3  # a large rotation
     with pytest.raises(ValueError, match="out-of-plane"):
-        scene(text.replace("force = [-4e4, 0, -2e4]", "force = [0, 1, 0]") + '[model]\nplane = "xz"\n')
+        scene(
+            text.replace("force = [-4e4, 0, -2e4]", "force = [0, 1, 0]") + '[model]\nplane = "xz"\n'
+        )
 
 
 def test_beams_of_different_degree_share_the_highest():

@@ -24,12 +24,32 @@ DEFAULT_OPTIONS = {
 }
 
 
+#: PETSc log events that make up the linear solves: (sparse) LU factorisation and the
+#: triangular solves (MUMPS is called through them)
+LINEAR_EVENTS = {
+    "factorise": ("MatLUFactorSym", "MatLUFactorNum"),
+    "triangular_solve": ("MatSolve",),
+}
+
+
+def linear_solve_seconds():
+    """Seconds spent so far in the :data:`LINEAR_EVENTS` (PETSc logging, started here)."""
+    from petsc4py import PETSc
+
+    PETSc.Log.begin()  # idempotent; the cost is a few counters per event
+    return {
+        key: sum(PETSc.Log.Event(name).getPerfInfo()["time"] for name in names)
+        for key, names in LINEAR_EVENTS.items()
+    }
+
+
 class SolveReport(NamedTuple):
     converged: bool
     reason: str
     iterations: int
     residuals: tuple  # ‖F‖ at each iteration
-    seconds: dict  # wall time split: assemble_F, assemble_J, solve
+    seconds: dict  # wall time: assemble_F, assemble_J, solve (= the rest: factorise,
+    # triangular_solve, python = Python, SNES and vector work)
 
 
 class SolveFailed(RuntimeError):
@@ -67,6 +87,7 @@ class NewtonSolver:
         self.A = fp.create_matrix(self.J)
         self.x = w.vector.copy()
         self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0}
+        linear_solve_seconds()  # start PETSc's event log before the first solve
         self._residuals = []
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
@@ -104,6 +125,7 @@ class NewtonSolver:
         """Run Newton from the current ``w``; ``w`` holds the last iterate. Returns a report."""
         self._residuals = []
         before = dict(self.seconds)
+        linear_before = linear_solve_seconds()
         t = time.perf_counter()
         self.w.vector.copy(self.x)
         self.snes.solve(None, self.x)
@@ -114,6 +136,12 @@ class NewtonSolver:
         seconds = {k: self.seconds[k] - before[k] for k in self.seconds}
         seconds["solve"] = total - seconds["assemble_F"] - seconds["assemble_J"]
         self.seconds["solve"] += seconds["solve"]
+        linear = linear_solve_seconds()
+        for key in LINEAR_EVENTS:
+            seconds[key] = linear[key] - linear_before[key]
+        seconds["python"] = seconds["solve"] - seconds["factorise"] - seconds["triangular_solve"]
+        for key in (*LINEAR_EVENTS, "python"):
+            self.seconds[key] = self.seconds.get(key, 0.0) + seconds[key]
         residuals = tuple(self._residuals)
         # a step-size (stol) stop is only convergence if the residual did not grow
         converged = (
