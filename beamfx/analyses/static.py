@@ -16,16 +16,28 @@ class StaticResult(NamedTuple):
 
 
 class _State:
-    """Save/restore of the unknowns for cut-backs."""
+    """Save/restore of the unknowns for cut-backs, and the secant predictor."""
 
     def __init__(self, w):
         self.w, self.saved = w, w.x.array.copy()
+        self.last = self.previous = None  # (load factor, unknowns) of converged states
 
     def save(self):
         self.saved[:] = self.w.x.array
 
     def restore(self):
         self.w.x.array[:] = self.saved
+        self.w.x.scatter_forward()
+
+    def predict(self, lam, target):
+        """Start Newton from the secant through the last two converged states,
+        w = w_n + (λ − λ_n)/(λ_n − λ_{n−1}) (w_n − w_{n−1}), instead of from w_n."""
+        if self.last is None or self.last[0] < lam:
+            self.previous, self.last = self.last, (lam, self.saved.copy())
+        if self.previous is None:
+            return
+        (lam_0, w_0), (lam_1, w_1) = self.previous, self.last
+        self.w.x.array[:] = w_1 + (target - lam_1) / (lam_1 - lam_0) * (w_1 - w_0)
         self.w.x.scatter_forward()
 
 

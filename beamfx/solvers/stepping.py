@@ -27,7 +27,9 @@ def step_load(
 
     Args:
         solve_at: ``solve_at(load_factor) -> SolveReport``; starts from the current state.
-        state: object with ``save()`` and ``restore()`` of the unknowns, used on failure.
+        state: object with ``save()`` and ``restore()`` of the unknowns, used on failure, and
+            optionally ``predict(load_factor, target)``, which sets the starting point of
+            the step from the converged state at ``load_factor`` (just saved).
         steps: initial number of equal steps (the first step is 1/steps).
         min_fraction: smallest step allowed, as a fraction of the total load.
         easy_iterations: a step that converged in at most this many iterations lets the next
@@ -46,6 +48,8 @@ def step_load(
     while lam < 1.0 - 1e-14:
         target = min(1.0, lam + size)
         state.save()
+        if hasattr(state, "predict"):
+            state.predict(lam, target)
         report = solve_at(target)
         if report.converged:
             item = LoadStep(
