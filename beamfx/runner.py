@@ -35,6 +35,7 @@ def run_scene(path=None, out_dir=None, log=None):
         write_vtu,
     )
     from .io import log as default_log
+    from .io.surface import SurfaceSeries, model_outlines, write_paraview_script
     from .scene import load_scene
 
     log = log or default_log
@@ -50,12 +51,24 @@ def run_scene(path=None, out_dir=None, log=None):
     check_supported(scene.model)
 
     log(f"beamfx: {path} -> {out}/")
-    model = BeamModel(scene.model, comm, extra_points=scene.probes.values())
+    extra_points = [
+        *scene.probes.values(),
+        *filter(None, [scene.continuation.get("control_point")]),
+    ]
+    model = BeamModel(scene.model, comm, extra_points=extra_points)
+    if model.raised_degree:
+        log(
+            f"note: beams {model.raised_degree} raised to degree {model.degree} (one degree per mesh)"
+        )
     log(
         f"model: {len(scene.model.beams)} beam(s), {model.mesh.mesh.topology.index_map(1).size_global} elements, degree "
         f"{model.degree}, {model.unknowns()} unknowns, {'finite' if model.kin.finite else 'linear'} kinematics"
     )
     pvd, xdmf = PvdSeries(out / "deformed.pvd"), XdmfSeries(out / "deformed.xdmf")
+    names = [b.name for b in scene.model.beams]
+    outlines = model_outlines(scene.model.beams)
+    surface = SurfaceSeries(out / "surface.pvd", model.degree, names, outlines)
+    write_paraview_script(out)
     latest = {}  # probe values of the last accepted step, rotations tracked along the path
 
     def on_step(step):
@@ -64,12 +77,17 @@ def run_scene(path=None, out_dir=None, log=None):
         write_vtu(vtu, fields)
         pvd.add(step.load_factor, vtu)
         xdmf.add(step.load_factor, fields)
+        surface.add(step.step, step.load_factor, fields)
         values = evaluate_points(model, list(scene.probes.values()))
         latest["probes"] = track_rotations(latest.get("probes"), values)
 
-    result = solve_static(
-        model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
-    )
+    extra = {}
+    if scene.analysis == "arclength":
+        result, extra = _trace(model, scene, out, on_step, log)
+    else:
+        result = solve_static(
+            model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
+        )
     final = latest["probes"]
     results = {
         "scene": str(path),
@@ -80,6 +98,7 @@ def run_scene(path=None, out_dir=None, log=None):
             "degree": model.degree,
             "unknowns": model.unknowns(),
             "kinematics": "finite" if model.kin.finite else "linear",
+            "plane": model.kin.plane,
             "shear": model.kin.shear,
             "stretch": model.kin.stretch,
         },
@@ -93,10 +112,16 @@ def run_scene(path=None, out_dir=None, log=None):
             }
             for s in result.steps
         ],
-        "newton_iterations": result.newton_iterations,
+        "newton_iterations": int(sum(s.iterations for s in result.steps)),
+        **extra,
         "wall_time_s": {**result.seconds, "run": time.perf_counter() - t_start},
         "probes": {name: final[at] for name, at in scene.probes.items()},
-        "paraview": {"pvd": "deformed.pvd", "xdmf": "deformed.xdmf"},
+        "paraview": {
+            "pvd": "deformed.pvd",
+            "xdmf": "deformed.xdmf",
+            **({"surface": "surface.pvd"} if any(outlines.values()) else {}),
+            "script": "open_in_paraview.py",
+        },
     }
     write_json_atomic(results_file, results)
     log(f"done in {results['wall_time_s']['run']:.2f} s; results in {results_file}")
@@ -106,6 +131,64 @@ def run_scene(path=None, out_dir=None, log=None):
             f"displacement {[round(x, 6) for x in v['displacement']]}"
         )
     return results
+
+
+def _trace(model, scene, out, on_step, log):
+    """Arc-length continuation of a scene; the path is written to ``path.csv`` as it goes."""
+    from types import SimpleNamespace
+
+    from mpi4py import MPI
+
+    from .analyses.continuation import limit_points, trace_path
+    from .solvers.arclength import ArcLengthSettings
+
+    settings = dict(scene.continuation)
+    method = settings.pop("method")
+    csv = out / "path.csv"
+    if MPI.COMM_WORLD.rank == 0:
+        csv.write_text("step,load_factor,ux,uy,uz,arc_length,iterations\n")
+
+    def record(point):
+        step = SimpleNamespace(step=len(record.points), load_factor=point.load_factor)
+        record.points.append(point)
+        if MPI.COMM_WORLD.rank == 0:
+            with csv.open("a") as f:
+                u = ",".join(f"{x:.12g}" for x in point.displacement)
+                f.write(
+                    f"{step.step},{point.load_factor:.12g},{u},{point.arc_length:.12g},"
+                    f"{point.iterations}\n"
+                )
+        on_step(step)
+
+    record.points = []
+    result = trace_path(
+        model,
+        **settings,
+        settings=ArcLengthSettings(method=method),
+        options=scene.solver_options,
+        on_step=record,
+        log=log,
+    )
+    control = result.control_point
+    extra = {
+        "control_point": control,
+        "path": [
+            {
+                "load_factor": p.load_factor,
+                "displacement": p.displacement.tolist(),
+                "arc_length": p.arc_length,
+            }
+            for p in result.path
+        ],
+        "limit_points": [
+            {"kind": p.kind, "load_factor": p.load_factor, "displacement": p.displacement.tolist()}
+            for p in limit_points(result.path)
+        ],
+        "stopped_by": result.reason,
+    }
+    for p in extra["limit_points"]:
+        log(f"  limit point ({p['kind']}): load factor {p['load_factor']:.6g} at {control}")
+    return result, extra
 
 
 def check_scene(path):

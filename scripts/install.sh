@@ -13,6 +13,7 @@ PY=/usr/bin/python3
 APT_PKGS=(
   python3-dolfinx python3-petsc4py python3-slepc4py python3-gmsh python3-meshio
   python3-mpi4py openmpi-bin python3-venv python3-dev build-essential git make
+  paraview python3-paraview xvfb xauth  # pvpython; Debian's ParaView renders through X only
 )
 PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib ruff)
 

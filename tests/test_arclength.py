@@ -191,3 +191,27 @@ def test_bratu_fold_with_state_dependent_load():
     lam_c = np.polyval(c, -c[1] / (2 * c[0]))
     # FE error of the fold at 16 P2 cells 8e-6 (32 cells: 3e-6, then the parabola's O(Δs³))
     assert abs(lam_c - BRATU_LAMBDA_C) < 5e-5
+
+
+def test_lee_frame_from_its_scene_file(tmp_path):
+    """The documented arc-length scene (planar model): limit load and the path file."""
+    import json
+    import re
+    from pathlib import Path
+
+    from beamfx.runner import run_scene
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
+    text = next(b for b in re.findall(r"```toml\n(.*?)```", doc, re.S) if "Lee's frame" in b)
+    scene = tmp_path / "lee.toml"
+    scene.write_text(text.replace('dir = "results/lee_frame"', f'dir = "{tmp_path / "out"}"'))
+    results = run_scene(scene, log=lambda *a: None)
+    assert results["model"]["plane"] == "xy" and results["model"]["unknowns"] == 183
+    top = results["limit_points"][0]
+    assert top["kind"] == "maximum"
+    assert abs(top["load_factor"] - P_MAX) <= P3_NE10_RTOL * P_MAX
+    assert results["stopped_by"] == "stop"
+    assert abs(results["path"][-1]["displacement"][1]) >= 55
+    rows = (tmp_path / "out" / "path.csv").read_text().splitlines()
+    assert len(rows) == len(results["path"])  # header + one row per step after the start
+    assert json.loads((tmp_path / "out" / "results.json").read_text())["converged"]

@@ -29,6 +29,7 @@ class Section:
     EI_z: float
     rho_A: float = 0.0
     rho_I: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    shape: tuple = ()  # ("rectangle", h, w), ("tube", d, d_inner); () if only stiffnesses
 
     @property
     def C_N(self):
@@ -88,8 +89,9 @@ def cowper_tube(nu, m):
     return 6 * (1 + nu) * (1 + m**2) ** 2 / ((7 + 6 * nu) * (1 + m**2) ** 2 + (20 + 12 * nu) * m**2)
 
 
-def _from_geometry(E, G, rho, A, I_y, I_z, J, k_y, k_z):
+def _from_geometry(E, G, rho, A, I_y, I_z, J, k_y, k_z, shape):
     return Section(
+        shape=shape,
         EA=E * A,
         GA_y=k_y * G * A,
         GA_z=k_z * G * A,
@@ -119,7 +121,7 @@ def rectangle(E, G, rho, h, w, torsion="saint-venant", shear_factor=None, nu=Non
         if shear_factor is not None
         else cowper_rectangle(E / (2 * G) - 1 if nu is None else nu)
     )
-    return _from_geometry(E, G, rho, A, I_y, I_z, J, k, k)
+    return _from_geometry(E, G, rho, A, I_y, I_z, J, k, k, ("rectangle", h, w))
 
 
 def tube(E, G, rho, d, d_inner=0.0, shear_factor=None, nu=None):
@@ -128,7 +130,7 @@ def tube(E, G, rho, d, d_inner=0.0, shear_factor=None, nu=None):
     I = math.pi * (d**4 - d_inner**4) / 64
     nu = E / (2 * G) - 1 if nu is None else nu
     k = shear_factor if shear_factor is not None else cowper_tube(nu, d_inner / d)
-    return _from_geometry(E, G, rho, A, I, I, 2 * I, k, k)
+    return _from_geometry(E, G, rho, A, I, I, 2 * I, k, k, ("tube", d, d_inner))
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,148 @@
+"""Show the results of ``beamfx run`` in ParaView: the beam's section swept along the deformed
+centre line, coloured by |u|, over the undeformed centre line in grey.
+
+``beamfx run`` copies this file into its output folder. From there:
+
+    paraview --script=open_in_paraview.py            # interactive
+    pvpython open_in_paraview.py --png beam.png      # a picture (off-screen)
+
+Without a display (Debian's ParaView renders through X only) prefix ``xvfb-run -a``. Runs in
+ParaView's own Python: it imports nothing from beamfx. Reads ``deformed.pvd`` (the centre
+line, arrays X, u, e1..e3, N, M) and ``surface.pvd`` (the surface, arrays u, N, M) beside it,
+or in the folder given with ``--dir``.
+"""
+
+import argparse
+import os
+import sys
+
+import paraview.simple as pvs
+
+# view direction from the scene towards the camera, and the up vector (global axes)
+VIEW_DIRECTION = (1.0, -1.0, 0.8)
+VIEW_UP = (0.0, 0.0, 1.0)
+
+
+# the folder this copy was written to (set by beamfx when it copies the script)
+WRITTEN_TO = None
+
+
+def _default_dir():
+    try:
+        return os.path.dirname(os.path.abspath(__file__))
+    except NameError:  # paraview --script=... runs the code without __file__ (and argv)
+        if os.path.exists("deformed.pvd") or not WRITTEN_TO:
+            return os.getcwd()
+        return WRITTEN_TO
+
+
+def _last_time(reader):
+    times = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
+    return times[-1]
+
+
+def show_results(folder, view=None, time=None):
+    """Load and show the two series of ``folder``; returns a dict of the proxies.
+
+    Args:
+        folder: the results folder (deformed.pvd; surface.pvd if present).
+        view: a render view (the active one if None).
+        time: the load factor to show (the last one if None).
+    """
+    view = view or pvs.GetActiveViewOrCreate("RenderView")
+    out = {"view": view}
+    line = pvs.PVDReader(FileName=os.path.join(folder, "deformed.pvd"))
+    out["deformed"] = line
+    time = _last_time(line) if time is None else time
+    # undeformed centre line: the points moved back to the reference positions X
+    ref = pvs.Calculator(Input=line, ResultArrayName="X_ref", Function="X")
+    ref.CoordinateResults = 1
+    ref_show = pvs.Show(ref, view)
+    ref_show.ColorArrayName = ["POINTS", ""]
+    ref_show.AmbientColor = ref_show.DiffuseColor = (0.55, 0.55, 0.55)
+    ref_show.LineWidth = 3.0
+    ref_show.RenderLinesAsTubes = 1
+    out["undeformed"] = ref
+
+    surface_file = os.path.join(folder, "surface.pvd")
+    if os.path.exists(surface_file):
+        surface = pvs.PVDReader(FileName=surface_file)
+        normals = pvs.GenerateSurfaceNormals(Input=pvs.ExtractSurface(Input=surface))
+        normals.FeatureAngle = 40.0  # sharp rectangle edges, smooth circles
+        shown, out["surface"] = normals, surface
+    else:  # no section outline: draw the deformed centre line itself
+        shown = line
+    disp = pvs.Show(shown, view)
+    pvs.ColorBy(disp, ("POINTS", "u", "Magnitude"))
+    lut = pvs.GetColorTransferFunction("u")
+    lut.ApplyPreset("Viridis (matplotlib)", True)
+    disp.LineWidth = 4.0
+    disp.Specular = 0.3
+    disp.RescaleTransferFunctionToDataRange(False, True)
+    disp.SetScalarBarVisibility(view, True)
+    bar = pvs.GetScalarBar(lut, view)
+    bar.Title, bar.ComponentTitle = "displacement", "magnitude"
+    bar.TitleColor = bar.LabelColor = (0.1, 0.1, 0.1)
+    bar.WindowLocation = "Upper Right Corner"
+    bar.HorizontalTitle = 1
+    bar.ScalarBarLength = 0.3
+    bar.TitleFontSize, bar.LabelFontSize = 18, 16
+    bar.RangeLabelFormat = "%-#.3g"
+    out["display"] = disp
+
+    label = pvs.Text(Text=f"{os.path.basename(os.path.abspath(folder))}: load factor {time:g}")
+    label_show = pvs.Show(label, view)
+    label_show.WindowLocation = "Upper Left Corner"
+    label_show.FontSize, label_show.Color = 18, (0.1, 0.1, 0.1)
+    out["label"] = label
+    view.ViewTime = time
+    scene = pvs.GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    scene.AnimationTime = time
+    view.Background = (1.0, 1.0, 1.0)
+    try:  # ParaView >= 5.10 has a background palette that overrides Background
+        view.UseColorPaletteForBackground = 0
+    except AttributeError:
+        pass
+    view.OrientationAxesVisibility = 1
+    view.UseFXAA = 1  # anti-aliasing: thin beams and their edges without jaggies
+    disp.RescaleTransferFunctionToDataRange(False, True)
+    fit_camera(view)
+    return out
+
+
+def fit_camera(view, direction=VIEW_DIRECTION, up=VIEW_UP, zoom=1.3):
+    """Look at everything shown from ``direction`` (towards the camera), ``up`` upwards,
+    ``zoom`` times closer than ParaView's reset (which leaves room for any rotation)."""
+    pvs.Render(view)  # the first render resets the camera: do it before setting ours
+    view.CameraFocalPoint = (0.0, 0.0, 0.0)
+    view.CameraPosition = direction
+    view.CameraViewUp = up
+    view.CameraParallelProjection = 0
+    view.ResetCamera(False)
+    pvs.GetActiveCamera().Dolly(zoom)
+    pvs.Render(view)
+
+
+def save_png(view, path, size=(1200, 900)):
+    """Render ``view`` at ``size`` pixels to ``path``, fonts at their size on screen."""
+    view.ViewSize = list(size)
+    fit_camera(view)  # the aspect ratio changed
+    pvs.SaveScreenshot(path, view, ImageResolution=list(size), FontScaling="Do not scale fonts")
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--dir", default=_default_dir(), help="results folder (default: this one)")
+    p.add_argument("--png", help="save a picture here instead of staying open")
+    p.add_argument("--size", type=int, nargs=2, default=(1200, 900), metavar=("W", "H"))
+    p.add_argument("--time", type=float, help="load factor to show (default: the last)")
+    args, _ = p.parse_known_args(argv)
+    shown = show_results(args.dir, time=args.time)
+    if args.png:
+        save_png(shown["view"], args.png, args.size)
+    return shown
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

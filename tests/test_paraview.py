@@ -1,0 +1,105 @@
+"""ParaView reads what ``beamfx run`` writes: the default scene checked and rendered in pvpython.
+
+ParaView's own Python runs ``beamfx/io/pvscripts/pvcheck.py`` on the results folder: it
+opens deformed.pvd, deformed.xdmf and surface.pvd, checks their arrays and that the deformed
+tip of the 45-degree bend is where the solver put it, and renders the picture of
+``open_in_paraview.py`` off-screen. Debian's ParaView renders through X only (no EGL or
+OSMesa), so without a display the test starts its own Xvfb; ``-displayfd`` lets the server
+pick a free display, which ``xvfb-run -a`` does racily when several run at once.
+
+MPI: the scene runs on all ranks, pvpython on rank 0 only; its verdict is broadcast.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+from mpi4py import MPI
+
+import beamfx.io.pvscripts
+from beamfx.runner import default_scene_path, run_scene
+
+pytestmark = pytest.mark.paraview
+comm = MPI.COMM_WORLD
+PVCHECK = Path(beamfx.io.pvscripts.__file__).with_name("pvcheck.py")
+PVPYTHON = shutil.which("pvpython")
+XVFB = shutil.which("Xvfb")
+# Bathe & Bolourchi (1979) give (15.9, 47.2, 53.4), published values spread by ~0.4; this
+# checks the files against the solver's own tip (probe), so the tolerance is a file-level one
+TIP_TOL = 1e-3
+
+
+@contextmanager
+def display():
+    """Environment with a usable DISPLAY (the current one, or a private Xvfb), without the
+    variables of mpirun: pvpython links MPI, and its MPI_Init fails on a rank's settings."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    if env.get("DISPLAY"):
+        yield env
+        return
+    r, w = os.pipe()
+    server = subprocess.Popen(
+        [XVFB, "-displayfd", str(w), "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+        pass_fds=(w,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(w)
+    try:
+        with os.fdopen(r) as f:
+            number = f.readline().strip()  # written once the server accepts connections
+        if not number:
+            raise RuntimeError("Xvfb did not start")
+        env["DISPLAY"] = f":{number}"
+        yield env
+    finally:
+        server.terminate()
+        server.wait(timeout=10)
+
+
+@pytest.mark.skipif(PVPYTHON is None, reason="pvpython not found (apt: python3-paraview)")
+@pytest.mark.skipif(
+    not os.environ.get("DISPLAY") and XVFB is None,
+    reason="no DISPLAY and no Xvfb (apt: xvfb) for ParaView's X-only rendering",
+)
+def test_paraview_reads_and_renders_bend45(tmp_path):
+    out = Path(comm.bcast(str(tmp_path), root=0)) / "bend45"
+    results = run_scene(default_scene_path(), out_dir=out, log=lambda message: None)
+    tip = results["probes"]["tip"]["position"]
+    assert tip == pytest.approx([15.6, 46.9, 53.6], abs=0.1)
+    assert (out / results["paraview"]["script"]).is_file()
+
+    report, error = None, None
+    if comm.rank == 0:
+        png = out / "check.png"
+        with display() as env:
+            cmd = [PVPYTHON, str(PVCHECK), str(out), "--png", str(png), "--size", "640", "480"]
+            cmd += ["--tip", *map(str, tip), "--tol", str(TIP_TOL)]
+            run = subprocess.run(
+                cmd, env=env, capture_output=True, text=True, timeout=120, check=False
+            )
+        lines = [ln for ln in run.stdout.splitlines() if ln.startswith("{")]
+        if run.returncode != 0 or not lines:
+            error = f"pvcheck exit {run.returncode}\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
+        else:
+            report = json.loads(lines[-1])
+    report, error = comm.bcast((report, error), root=0)
+    assert error is None, error
+    assert report["ok"], report["failed"]
+
+    files = report["files"]
+    assert {f["times"] for f in files.values() if "times" in f} == {len(results["load_steps"])}
+    assert files["surface.pvd"]["points"] > files["deformed.pvd"]["points"]
+    # the 1 x 1 section at the clamped start (centre line along y, at the origin) spans
+    # x and z from -1/2: the surface's box reaches 1/2 below the line's there
+    line, surface = files["deformed.pvd"]["bounds"], files["surface.pvd"]["bounds"]
+    assert [surface[0], surface[4]] == pytest.approx([line[0] - 0.5, line[4] - 0.5], abs=1e-6)
+    image = files["png"]
+    assert image["size"] == [640, 480]
+    assert Path(image["path"]).stat().st_size > 5000
+    assert image["colours"] > 50  # shaded and colour-mapped, not one flat colour
+    assert 0.005 < image["foreground"] < 0.5  # the beam is in the picture, and not all of it

@@ -1,0 +1,77 @@
+"""The swept section surface (beamfx.io.surface), on hand-made nodal fields: no solve.
+
+A straight beam along x (section axes = global axes) of 2 quadratic elements, displaced by a
+constant u: every ring of the surface is the outline moved to x + u, faces point away from
+the material, and the ends are closed.
+"""
+
+import numpy as np
+import pytest
+
+from beamfx.io.surface import VTK_POLYGON, VTK_QUAD, section_outline, surface_mesh
+
+K, ELEMENTS, SUB = 2, 2, 4
+U = np.array([0.1, 0.2, 0.3])
+
+
+def straight_fields():
+    xi = np.linspace(0, 1, K + 1)
+    X = np.concatenate([np.c_[e + xi, 0 * xi, 0 * xi] for e in range(ELEMENTS)])
+    n = len(X)
+    eye = np.eye(3)
+    return {
+        "X": X,
+        "u": np.tile(U, (n, 1)),
+        "e1": np.tile(eye[0], (n, 1)),
+        "e2": np.tile(eye[1], (n, 1)),
+        "e3": np.tile(eye[2], (n, 1)),
+        "N": np.zeros((n, 3)),
+        "M": np.tile([0.0, 1.0, 0.0], (n, 1)),
+        "beam": np.zeros(n),
+    }
+
+
+def outward(points, cell):
+    """Normal of a planar cell (right-hand rule) dotted with the direction away from the axis."""
+    p = points[cell]
+    normal = np.cross(p[1] - p[0], p[2] - p[0])
+    centre = p.mean(0)
+    away = centre - (U + [centre[0] - U[0], 0, 0])  # from the centre line, in the section plane
+    if np.ptp(p[:, 0]) < 1e-12:  # an end cap (in one section plane): away along the axis
+        away = np.array([np.sign(centre[0] - U[0] - ELEMENTS / 2), 0, 0])
+    return normal @ away
+
+
+@pytest.mark.parametrize(
+    "outline, rings_points, caps",
+    [
+        (section_outline("rectangle", h=1.0, w=0.5), 4, 2),
+        (section_outline("circle", d=1.0, segments=12), 12, 2),
+        (section_outline("tube", d=1.0, d_inner=0.6, segments=12), 24, 24),
+    ],
+)
+def test_swept_surface(outline, rings_points, caps):
+    points, cells, types, data = surface_mesh(straight_fields(), K, ["b"], {"b": outline}, SUB)
+    samples = ELEMENTS * (SUB + 1)
+    assert len(points) == samples * rings_points
+    along = ELEMENTS * SUB * rings_points
+    assert len(cells) == along + caps
+    assert np.all(types[:along] == VTK_QUAD)
+    assert set(types[along:]) == {VTK_QUAD if len(outline) == 2 else VTK_POLYGON}
+    yz = np.concatenate(outline)
+    rings = points.reshape(samples, rings_points, 3) - U
+    assert np.allclose(rings[..., 1:], yz[None])  # the outline, unrotated (axes = identity)
+    s = np.repeat(np.arange(ELEMENTS), SUB + 1) + np.tile(np.linspace(0, 1, SUB + 1), ELEMENTS)
+    assert np.allclose(rings[..., 0], s[:, None])
+    inner = min(np.linalg.norm(lp, axis=1).max() for lp in outline)  # a tube's hole
+    for c in cells:
+        r = np.linalg.norm(points[c][:, 1:] - U[1:], axis=1)
+        hole = len(outline) == 2 and np.allclose(r, inner)  # the hole's wall: towards the axis
+        assert outward(points, c) * (-1 if hole else 1) > 0
+    assert np.allclose(data["u"], U) and np.allclose(data["M"], [0, 1, 0])
+
+
+def test_general_section_has_no_outline():
+    assert section_outline("general") is None
+    points, cells, _, _ = surface_mesh(straight_fields(), K, ["b"], {"b": None})
+    assert len(points) == 0 and cells == []
