@@ -61,6 +61,6 @@ def register(case):
 
 def all_cases():
     """Import every paper module (they register their cases) and return the registry."""
-    from . import classic, howcroft_2016, schwab_meijaard_2009  # noqa: F401
+    from . import classic, howcroft_2016, schwab_meijaard_2009, schwab_meijaard_eigen  # noqa: F401
 
     return REGISTRY

@@ -1,0 +1,279 @@
+r"""Linearised buckling: det(K* + μ K_g) = 0 about a state (w*, λ*) on a load path.
+
+The path direction dw/dλ solves K* dw = −∂F/∂λ (the load vector), with the rate of any
+prescribed values on the constrained dofs. Two choices of K_g (``kg``):
+
+* ``"stress"`` (default, the classical one): the stress (initial-stress) stiffness of the
+  section force and moment rates Ṅ = C_N Γ̇, Ṁ = C_M K̇ along the path,
+  K_σ(δw, Δw) = ∫ Ṅ·δ²Γ[δw, Δw] + Ṁ·δ²K[δw, Δw] ds at w*, plus the load-stiffness rate
+  (tangent at λ* + 1 minus tangent at λ*, exact because the residual is affine in λ). Only
+  second derivatives of the strains: it compiles like the tangent. The expansion is
+  SPACAR's det(K0 + λ K_g) = 0 (Schwab & Meijaard 2009).
+* ``"path"``: the full derivative dK/dλ along w(λ* + h) = w* + h dw by a central difference
+  of compiled tangents (a third UFL derivative of the rotation energy takes minutes to compile,
+  DOLFINx notes §5). It also holds the initial-displacement matrix Ḃᵀ C B + Bᵀ C Ḃ, which
+  scales with the section stiffness; the first-order expansion then drops terms of the same
+  size at second order. Right when the pre-buckling path has no rotation (Euler buckling;
+  error ~ P/EA), and as λ* → λ_cr; wrong far from the critical point when the path rotates
+  (lateral buckling: a spurious root ∝ 1/sqrt(GA)). The quaternion penalty's share (its stiff
+  rank-one k_p q qᵀ turns with q) is removed: on an equilibrium path its multiplier is zero.
+
+:func:`solve_buckling` with ``about="undeformed"``: the classical linear buckling analysis,
+pre-stress from one linear solve under the reference load (load factor 1) about the
+undeformed state, critical load factors = μ. ``about="current"``: about the current
+(pre-loaded, deformed) ``model.w`` at the current load factor λ*, critical factors λ* + μ.
+"""
+
+import time
+from typing import NamedTuple
+
+import numpy as np
+import ufl
+
+from ..physics import energy
+from ..physics.kinematics import strains
+from ..solvers.eigen import solve_eigen
+from ..solvers.forms import compile_form
+from .modal import to_functions
+
+
+class BucklingResult(NamedTuple):
+    load_factors: np.ndarray  # critical load factors λ* + μ, lowest positive μ first
+    increments: np.ndarray  # μ: load factor beyond the state analysed
+    modes: tuple  # dolfinx Functions on model.W
+    residuals: np.ndarray
+    path: object  # dolfinx Function: dw/dλ at the state analysed (the linear pre-stress state
+    # per unit load factor for about="undeformed")
+    seconds: dict
+
+
+def _tangent(A, J_form, bcs, diagonal):
+    import dolfinx.fem.petsc as fp
+
+    A.zeroEntries()
+    fp.assemble_matrix(A, J_form, bcs=bcs, diagonal=diagonal)
+    A.assemble()
+    return A
+
+
+def path_tangent(model, J_form, F_form):
+    """dw/dλ at the current state: K dw = −∂F/∂λ, with the rate of the prescribed values on the
+    constrained dofs (both with the load factor unchanged on return)."""
+    import dolfinx.fem.petsc as fp
+    from dolfinx import fem
+    from petsc4py import PETSc
+
+    from ..solvers.assembly import assemble_load
+
+    lam = float(model.load_factor.value)
+    # rate of the prescribed values, by a central difference of their (smooth) definitions
+    g = []
+    for h in (1e-3, -1e-3):
+        x = fp.create_vector(F_form)
+        x.set(0.0)
+        model.set_load_factor(lam + h)
+        fp.set_bc(x, model.bcs)
+        g.append(x)
+    model.set_load_factor(lam)
+    dg = g[0]
+    dg.axpy(-1.0, g[1])
+    dg.scale(1 / 2e-3)
+    g[1].destroy()
+
+    f = fp.create_vector(F_form)
+    assemble_load(f, F_form, model.load_factor, model.bcs)
+    A = fp.assemble_matrix(J_form)  # without conditions: lifting of the prescribed rates
+    A.assemble()
+    f.axpy(-1.0, A * dg)
+    fixed = constrained_dofs(model.bcs)
+    with f.localForm() as f_local, dg.localForm() as g_local:
+        f_local.array[fixed] = g_local.array[fixed]
+    _tangent(A, J_form, model.bcs, 1.0)
+
+    ksp = PETSc.KSP().create(model.comm)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    dw = fem.Function(model.W, name="path_tangent")
+    ksp.solve(f, dw.vector)
+    dw.x.scatter_forward()
+    for obj in (ksp, A, f, dg):
+        obj.destroy()
+    return dw
+
+
+def constrained_dofs(bcs):
+    """Local indices (ghosts included) of the dofs constrained by ``bcs``."""
+    if not bcs:
+        return np.empty(0, np.int32)
+    return np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
+
+
+def penalty_tangent(model):
+    """Second variation of the quaternion penalty alone (None for the linear kinematics)."""
+    if not model.kin.finite:
+        return None
+    rot = ufl.split(model.w)[1]
+    Pi = energy.quaternion_penalty(rot, model.k_penalty, model.dx)
+    v, dw = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
+    return ufl.derivative(ufl.derivative(Pi, model.w, v), model.w, dw)
+
+
+def stress_stiffness_ufl(model, w_star, dw):
+    """K_σ (UFL): second variation at ``model.w`` of ∫ Ṅ·Γ(w) + Ṁ·K(w) ds, with the section
+    force and moment rates Ṅ = C_N Γ̇, Ṁ = C_M K̇ at ``w_star`` in the path direction ``dw``
+    (both Functions, held fixed)."""
+    kin, t0, Lam0 = model.kin, model.t0, model.Lam0
+    G_star, K_star = strains(kin, *ufl.split(w_star), t0, Lam0)
+    N = model.C_N * ufl.derivative(G_star, w_star, dw)
+    M = model.C_M * ufl.derivative(K_star, w_star, dw)
+    Gamma, K = strains(kin, *ufl.split(model.w), t0, Lam0)
+    Pi = ufl.dot(N, Gamma) * model.dx_shear + ufl.dot(M, K) * model.dx
+    v, dw_ = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
+    return ufl.derivative(ufl.derivative(Pi, model.w, v), model.w, dw_)
+
+
+def stress_stiffness(model, J_form, S_form):
+    """K_σ plus the load-stiffness rate, with zero constrained rows and columns."""
+    import dolfinx.fem.petsc as fp
+
+    lam = float(model.load_factor.value)
+    Kg = fp.assemble_matrix(S_form, bcs=model.bcs, diagonal=0.0)
+    Kg.assemble()
+    for value, sign in ((lam + 1.0, 1.0), (lam, -1.0)):
+        model.load_factor.value = value  # only the loads: the conditions do not enter J
+        A = fp.assemble_matrix(J_form, bcs=model.bcs, diagonal=0.0)
+        A.assemble()
+        Kg.axpy(sign, A)
+        A.destroy()
+    model.load_factor.value = lam
+    return Kg
+
+
+def geometric_stiffness(model, J_form, P_form, dw, eps=1e-4):
+    """K_g = dK/dλ along w(λ* + h) = w* + h dw, load factor λ* + h, by a central difference.
+
+    h = eps / max|dw| (displacements over the model's size, quaternion components as they
+    are), so the perturbation is small in rotation and in strain but far above round-off.
+    Constrained rows and columns are zero. The penalty's share (``P_form``) is removed.
+    """
+    import dolfinx.fem.petsc as fp
+
+    w, lam = model.w, float(model.load_factor.value)
+    w_star = w.x.array.copy()
+    h = eps / max(_scaled_max(model, dw), 1e-300)
+    mats = []
+    for sign in (1.0, -1.0):
+        w.x.array[:] = w_star + sign * h * dw.x.array
+        w.x.scatter_forward()
+        model.set_load_factor(lam + sign * h)
+        A = fp.assemble_matrix(J_form, bcs=model.bcs, diagonal=0.0)
+        A.assemble()
+        if P_form is not None:
+            Ap = fp.assemble_matrix(P_form, bcs=model.bcs, diagonal=0.0)
+            Ap.assemble()
+            A.axpy(-1.0, Ap)
+            Ap.destroy()
+        mats.append(A)
+    w.x.array[:] = w_star
+    w.x.scatter_forward()
+    model.set_load_factor(lam)
+    Kg, minus = mats
+    Kg.axpy(-1.0, minus)
+    Kg.scale(1 / (2 * h))
+    minus.destroy()
+    return Kg
+
+
+def _scaled_max(model, f):
+    """max over the dofs of |u| / size and |rotation components|. Collective."""
+    from mpi4py import MPI
+
+    x = model.mesh.mesh.geometry.x
+    size = model.comm.allreduce(np.ptp(x, axis=0).max() if len(x) else 0.0, op=MPI.MAX)
+    local = 0.0
+    for sub, scale in ((0, 1.0 / max(size, 1e-300)), (1, 1.0)):
+        dofs = model.W.sub(sub).collapse()[1]
+        if len(dofs):
+            local = max(local, scale * np.abs(f.x.array[dofs]).max())
+    return model.comm.allreduce(local, op=MPI.MAX)
+
+
+def solve_buckling(
+    model,
+    n_modes=4,
+    about="undeformed",
+    kg="stress",
+    options=None,
+    prefix="beamfx_buckling_",
+    eps=1e-4,
+):
+    """The ``n_modes`` lowest positive critical load factors and their modes.
+
+    Solves K* x = μ (−K_g) x (GNHEP: with non-conservative loads K_g is unsymmetric) by
+    shift-and-invert at μ = 0 and keeps the real positive μ. ``about``: "undeformed" (the
+    classical linear buckling analysis; the model is left undeformed at load factor 0) or
+    "current" (about ``model.w`` at the current load factor, both left unchanged). ``kg``:
+    "stress" or "path" (module doc); ``eps`` is the relative step of "path".
+
+    Raises:
+        ValueError: for the linear kinematics (no geometric stiffness) or a bad option.
+    """
+    import dolfinx.fem.petsc as fp
+    from dolfinx import fem
+
+    if about not in ("undeformed", "current"):
+        raise ValueError(f"about must be 'undeformed' or 'current', got {about!r}")
+    if kg not in ("stress", "path"):
+        raise ValueError(f"kg must be 'stress' or 'path', got {kg!r}")
+    if not model.kin.finite:
+        raise ValueError("buckling needs the finite kinematics: the linear model has no K_g")
+    t0 = time.perf_counter()
+    if about == "undeformed":
+        model.reset()
+        model.set_load_factor(0.0)
+    J_form, F_form = compile_form(model.J), compile_form(model.F)
+    t1 = time.perf_counter()
+    dw = path_tangent(model, J_form, F_form)
+    t2 = time.perf_counter()
+    if kg == "stress":
+        w_star = fem.Function(model.W)
+        w_star.x.array[:] = model.w.x.array
+        S_form = compile_form(stress_stiffness_ufl(model, w_star, dw))
+    else:
+        P = penalty_tangent(model)
+        P_form = compile_form(P) if P is not None else None
+    t3 = time.perf_counter()
+    K = fp.assemble_matrix(J_form, bcs=model.bcs, diagonal=1.0)
+    K.assemble()
+    if kg == "stress":
+        Kg = stress_stiffness(model, J_form, S_form)
+    else:
+        Kg = geometric_stiffness(model, J_form, P_form, dw, eps)
+    Kg.scale(-1.0)
+    t4 = time.perf_counter()
+    nev = 2 * n_modes + 2  # roots of both signs come out; keep the positive ones
+    pairs = solve_eigen(K, Kg, nev, 0.0, prefix, options, hermitian=False)
+    K.destroy()
+    Kg.destroy()
+    mu = pairs.values
+    keep = [
+        i for i in np.argsort(mu.real) if mu[i].real > 0 and abs(mu[i].imag) <= 1e-8 * abs(mu[i])
+    ][:n_modes]
+    for i in set(range(len(mu))) - set(keep):
+        pairs.vectors[i].destroy()
+    lam = float(model.load_factor.value)
+    seconds = {
+        "compile": (t1 - t0) + (t3 - t2),
+        "assemble": (t2 - t1) + (t4 - t3),
+        "solve": pairs.seconds,
+    }
+    return BucklingResult(
+        lam + mu.real[keep],
+        mu.real[keep],
+        to_functions(model, [pairs.vectors[i] for i in keep]),
+        pairs.residuals[keep],
+        dw,
+        seconds,
+    )

@@ -1,0 +1,127 @@
+"""Free vibration about the current state: det(K − ω² M) = 0.
+
+K is the tangent at ``model.w`` (and the current load factor), so a pre-stressed model gives the
+pre-stressed frequencies: run :func:`~beamfx.analyses.static.solve_static` first. M is the mass
+form of :mod:`beamfx.physics.inertia` about the same state. Constrained dofs have 1 on K's
+diagonal and 0 on M's, so they sit at ω² = ∞.
+"""
+
+import time
+from typing import NamedTuple
+
+import numpy as np
+import ufl
+
+from ..physics.inertia import mass_form
+from ..solvers.eigen import solve_eigen
+from ..solvers.forms import compile_form
+
+
+class ModalResult(NamedTuple):
+    eigenvalues: np.ndarray  # ω² (1/s²), nearest to the target first
+    omega: np.ndarray  # rad/s; sign(ω²)·sqrt|ω²|, so a (numerically) negative ω² stays visible
+    hz: np.ndarray
+    modes: tuple  # dolfinx Functions on model.W (increments of the unknowns)
+    residuals: np.ndarray  # SLEPc relative residual per pair
+    seconds: dict  # compile, assemble, solve
+
+
+def mass_ufl(model, rotary="full"):
+    """The mass form of ``model`` about its current state (UFL)."""
+    v = ufl.split(ufl.TestFunction(model.W))
+    dw = ufl.split(ufl.TrialFunction(model.W))
+    rot = ufl.split(model.w)[1]
+    return mass_form(model.kin, rot, v, dw, model.inertia, model.Lam0, model.dx, rotary)
+
+
+def assemble_pair(a, b, bcs):
+    """A = a with identity on the constrained rows, B = b with zeros there (compiled forms)."""
+    import dolfinx.fem.petsc as fp
+
+    A = fp.assemble_matrix(a, bcs=bcs, diagonal=1.0)
+    A.assemble()
+    B = fp.assemble_matrix(b, bcs=bcs, diagonal=0.0)
+    B.assemble()
+    return A, B
+
+
+def is_symmetric(A, rtol=1e-9):
+    """Whether ‖A − Aᵀ‖ ≤ rtol ‖A‖ (Frobenius). Collective."""
+    D = A.copy()
+    D.axpy(-1.0, A.transpose())
+    ok = D.norm() <= rtol * A.norm()
+    D.destroy()
+    return ok
+
+
+def free_shift(K, M):
+    """A small negative shift for target 0: a free structure has a singular K.
+
+    min_i K_ii / M_ii (over rows with mass) bounds the lowest ω² from above (Rayleigh quotient
+    of a unit vector); 1e-6 of it is far below the lowest elastic ω² of any mesh one would run,
+    yet far above the round-off of the rigid-body eigenvalues.
+    """
+    k, m = K.getDiagonal(), M.getDiagonal()
+    ka, ma = k.getArray(), m.getArray()
+    ratio = ka[ma > 0] / ma[ma > 0]
+    local = np.min(ratio) if len(ratio) else np.inf
+    k.destroy()
+    m.destroy()
+    return -1e-6 * K.getComm().tompi4py().allreduce(local, op=_mpi_min())
+
+
+def _mpi_min():
+    from mpi4py import MPI
+
+    return MPI.MIN
+
+
+def to_functions(model, vectors):
+    from dolfinx import fem
+
+    modes = []
+    for i, x in enumerate(vectors):
+        f = fem.Function(model.W, name=f"mode_{i}")
+        x.copy(f.vector)
+        f.x.scatter_forward()
+        x.destroy()
+        modes.append(f)
+    return tuple(modes)
+
+
+def solve_modes(
+    model, n_modes=6, target=0.0, options=None, prefix="beamfx_modal_", rotary="full", shift=None
+):
+    """The ``n_modes`` vibration modes with ω² nearest to ``target`` (1/s²), about ``model.w``.
+
+    Krylov–Schur with shift-and-invert (MUMPS). At target 0 the shift defaults to a small
+    negative value (:func:`free_shift`), so that a free structure, whose K is singular, works:
+    its six rigid-body modes come out with ω² ≈ 0. ``rotary`` as in
+    :data:`beamfx.physics.inertia.ROTARY`. The problem is solved as GHEP when K is symmetric
+    (conservative loads), else GNHEP (e.g. fixed-axis moments).
+    """
+    t0 = time.perf_counter()
+    K_form, M_form = compile_form(model.J), compile_form(mass_ufl(model, rotary))
+    t1 = time.perf_counter()
+    K, M = assemble_pair(K_form, M_form, model.bcs)
+    t2 = time.perf_counter()
+    if shift is None and target == 0.0:
+        shift = free_shift(K, M)
+    pairs = solve_eigen(
+        K, M, n_modes, target, prefix, options, hermitian=is_symmetric(K), shift=shift
+    )
+    K.destroy()
+    M.destroy()
+    for x in pairs.vectors[n_modes:]:
+        x.destroy()
+    lam = pairs.values.real[:n_modes]
+    omega = np.sign(lam) * np.sqrt(np.abs(lam))
+    seconds = {"compile": t1 - t0, "assemble": t2 - t1, "solve": pairs.seconds}
+    return ModalResult(
+        lam,
+        omega,
+        omega / (2 * np.pi),
+        to_functions(model, pairs.vectors[:n_modes]),
+        pairs.residuals[:n_modes],
+        seconds,
+    )
