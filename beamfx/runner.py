@@ -53,7 +53,7 @@ def run_scene(path=None, out_dir=None, log=None):
     log(f"beamfx: {path} -> {out}/")
     extra_points = [
         *scene.probes.values(),
-        *filter(None, [scene.continuation.get("control_point")]),
+        *filter(None, [scene.settings.get("control_point")]),
     ]
     model = BeamModel(scene.model, comm, extra_points=extra_points)
     if model.raised_degree:
@@ -71,19 +71,31 @@ def run_scene(path=None, out_dir=None, log=None):
     write_paraview_script(out)
     latest = {}  # probe values of the last accepted step, rotations tracked along the path
 
-    def on_step(step):
+    def write(step, time):
+        """ParaView files of the current state as step ``step`` at ``time``."""
         fields = nodal_fields(model)
-        vtu = out / f"deformed_{step.step:04d}.vtu"
+        vtu = out / f"deformed_{step:04d}.vtu"
         write_vtu(vtu, fields)
-        pvd.add(step.load_factor, vtu)
-        xdmf.add(step.load_factor, fields)
-        surface.add(step.step, step.load_factor, fields)
+        pvd.add(time, vtu)
+        xdmf.add(time, fields)
+        surface.add(step, time, fields)
+
+    def on_step(step):
+        write(step.step, step.load_factor)
         values = evaluate_points(model, list(scene.probes.values()))
         latest["probes"] = track_rotations(latest.get("probes"), values)
 
     extra = {}
     if scene.analysis == "arclength":
         result, extra = _trace(model, scene, out, on_step, log)
+    elif scene.analysis in ("modal", "buckling"):
+        from .analyses.eigen_run import run_eigen
+
+        result, extra = run_eigen(model, scene, write, log)
+        if "probes" not in latest:
+            latest["probes"] = track_rotations(
+                None, evaluate_points(model, list(scene.probes.values()))
+            )
     else:
         result = solve_static(
             model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
@@ -142,7 +154,7 @@ def _trace(model, scene, out, on_step, log):
     from .analyses.continuation import limit_points, trace_path
     from .solvers.arclength import ArcLengthSettings
 
-    settings = dict(scene.continuation)
+    settings = dict(scene.settings)
     method = settings.pop("method")
     csv = out / "path.csv"
     if MPI.COMM_WORLD.rank == 0:

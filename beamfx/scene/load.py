@@ -30,7 +30,7 @@ from .table import SceneError, Table
 
 CURVE_SHAPES = ("line", "arc", "helix", "polyline", "spline", "gmsh")
 SECTION_TYPES = ("rectangle", "circle", "tube", "general")
-ANALYSES = ("static", "linear_static", "arclength")
+ANALYSES = ("static", "linear_static", "arclength", "modal", "buckling")
 FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
 
 
@@ -45,7 +45,7 @@ class Scene:
     probes: dict = field(default_factory=dict)  # name -> point ("beam:end")
     output_dir: str = "results"
     solver_options: dict = field(default_factory=dict)
-    continuation: dict = field(default_factory=dict)  # arc-length settings ([analysis])
+    settings: dict = field(default_factory=dict)  # [analysis] keys of arclength, modal, buckling
 
 
 def _curve(t, base):
@@ -298,7 +298,9 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     at = top.table("analysis", {})
     analysis = at.get("type", str, "static", choices=ANALYSES)
     steps = at.get("steps", int, 10, positive=True)
-    continuation = _continuation(at) if analysis == "arclength" else {}
+    settings = _continuation(at) if analysis == "arclength" else {}
+    if analysis in ("modal", "buckling"):
+        settings = _eigen(at, analysis)
     at.done()
     if analysis == "linear_static":
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
@@ -327,7 +329,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     )
     _check_points(model, probes, file)
     _check_model(model, file)
-    return Scene(file, model, analysis, steps, probes, out_dir, dict(solver), continuation)
+    return Scene(file, model, analysis, steps, probes, out_dir, dict(solver), settings)
 
 
 def _continuation(t):
@@ -351,6 +353,20 @@ def _continuation(t):
         t.fail(
             "type", "arclength needs target_load_factor or displacement_limit to know where to stop"
         )
+    return out
+
+
+def _eigen(t, analysis):
+    """Settings of a modal or buckling ``[analysis]``."""
+    out = {"modes": t.get("modes", int, 6 if analysis == "modal" else 4, positive=True)}
+    if analysis == "modal":
+        out["target_hz"] = t.get("target_hz", float, 0.0)
+        out["rotary_inertia"] = t.get(
+            "rotary_inertia", str, "full", choices=("full", "polar", "none")
+        )
+        out["prestress"] = t.get("prestress", bool, True)
+    else:
+        out["about"] = t.get("about", str, "undeformed", choices=("undeformed", "current"))
     return out
 
 

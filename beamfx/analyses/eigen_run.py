@@ -1,0 +1,107 @@
+"""Modal and buckling analyses of a scene: solve, then report modes at the probes and write one
+ParaView step per mode (behind ``beamfx run`` for ``[analysis] type = "modal"/"buckling"``)."""
+
+import numpy as np
+from mpi4py import MPI
+
+from .continuation import point_displacement, point_displacement_dofs
+
+
+def _mode_report(model, scene, modes):
+    """Mode shapes at the probes: displacement, scaled so that its largest nodal value is 1."""
+    names = list(dict.fromkeys(scene.probes.values()))
+    dofs = {at: point_displacement_dofs(model, at) for at in names}
+    _, u_dofs = model.W.sub(0).collapse()
+    w0 = model.w.x.array.copy()
+    out = []
+    for mode in modes:
+        peak = model.comm.allreduce(np.max(np.abs(mode.x.array[u_dofs]), initial=0.0), op=MPI.MAX)
+        model.w.x.array[:] = mode.x.array / (peak or 1.0)
+        out.append(
+            {
+                name: point_displacement(model, dofs[at]).tolist()
+                for name, at in scene.probes.items()
+            }
+        )
+    model.w.x.array[:] = w0
+    return out, w0
+
+
+def _write_modes(model, modes, write, w0):
+    """One ParaView step per mode (time = mode number): the state plus the mode, its largest
+    displacement scaled to a tenth of the model's size."""
+    _, u_dofs = model.W.sub(0).collapse()
+    x = model.mesh.mesh.geometry.x
+    size = model.comm.allreduce(float(np.ptp(x, axis=0).max()) if len(x) else 0.0, op=MPI.MAX)
+    for i, mode in enumerate(modes, start=1):
+        peak = model.comm.allreduce(np.max(np.abs(mode.x.array[u_dofs]), initial=0.0), op=MPI.MAX)
+        model.w.x.array[:] = w0 + 0.1 * size / (peak or 1.0) * mode.x.array
+        model.w.x.scatter_forward()
+        write(i, float(i))
+    model.w.x.array[:] = w0
+    model.w.x.scatter_forward()
+
+
+def run_eigen(model, scene, write, log):
+    """Solve the scene's modal or buckling analysis. Returns (result with ``steps``, results
+    entries for ``results.json``)."""
+    from types import SimpleNamespace
+
+    from .buckling import solve_buckling
+    from .modal import solve_modes
+    from .static import solve_static
+
+    settings = scene.settings
+    steps = ()
+    if scene.analysis == "modal":
+        mass = model.comm.allreduce(float(np.max(model.inertia.x.array, initial=0.0)), op=MPI.MAX)
+        if mass <= 0:
+            raise ValueError(
+                f"{scene.file}: a modal analysis needs mass: give [material] rho, or rho_A and "
+                "rho_I of the general sections"
+            )
+        loaded = (
+            scene.model.point_loads or scene.model.distributed_loads or any(scene.model.gravity)
+        )
+        if settings["prestress"] and loaded:
+            log("pre-stress: static solve under the scene's loads")
+            steps = solve_static(
+                model, steps=scene.steps, options=scene.solver_options, log=log
+            ).steps
+        target = (2 * np.pi * settings["target_hz"]) ** 2
+        res = solve_modes(
+            model,
+            settings["modes"],
+            target,
+            rotary=settings["rotary_inertia"],
+            options=scene.solver_options,
+        )
+        for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
+            log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s)")
+        shapes, w0 = _mode_report(model, scene, res.modes)
+        extra = {
+            "frequencies_hz": res.hz.tolist(),
+            "omega_rad_s": res.omega.tolist(),
+            "prestressed": bool(steps),
+            "mode_shapes": shapes,
+            "paraview_steps": "one per mode (time = mode number), displacement scaled to 1/10 of the model size",
+        }
+    else:
+        if settings["about"] == "current":
+            steps = solve_static(
+                model, steps=scene.steps, options=scene.solver_options, log=log
+            ).steps
+        res = solve_buckling(
+            model, settings["modes"], about=settings["about"], options=scene.solver_options
+        )
+        for i, lam in enumerate(res.load_factors, start=1):
+            log(f"  buckling mode {i}: load factor {lam:.8g}")
+        shapes, w0 = _mode_report(model, scene, res.modes)
+        extra = {
+            "load_factors": res.load_factors.tolist(),
+            "about": settings["about"],
+            "mode_shapes": shapes,
+            "paraview_steps": "one per mode (time = mode number), displacement scaled to 1/10 of the model size",
+        }
+    _write_modes(model, res.modes, write, w0)
+    return SimpleNamespace(steps=tuple(steps), seconds=dict(res.seconds)), extra
