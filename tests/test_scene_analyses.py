@@ -39,7 +39,9 @@ def _run(tmp_path, text):
 def test_modal_scene_gives_the_euler_bernoulli_cantilever_frequencies(tmp_path):
     EI, rho_A, L = 1e4, 2.0, 2.0
     text = CANTILEVER.format(EI=EI, rho_A=rho_A, out=tmp_path / "out")
-    results = _run(tmp_path, text + '[analysis]\ntype = "modal"\nmodes = 4\nrotary_inertia = "none"\n')
+    results = _run(
+        tmp_path, text + '[analysis]\ntype = "modal"\nmodes = 4\nrotary_inertia = "none"\n'
+    )
     f = np.array(results["frequencies_hz"])
     beta = np.array([1.8751040687, 4.6940911330])
     exact = beta**2 / (2 * np.pi) * np.sqrt(EI / (rho_A * L**4))
@@ -56,7 +58,9 @@ def test_modal_scene_gives_the_euler_bernoulli_cantilever_frequencies(tmp_path):
 def test_buckling_scene_gives_the_euler_load(tmp_path):
     EI, L = 1e4, 2.0
     text = CANTILEVER.format(EI=EI, rho_A=0.0, out=tmp_path / "out").replace("shear = false", "")
-    text += '[[loads]]\nat = "b:end"\nforce = [-1, 0, 0]\n\n[analysis]\ntype = "buckling"\nmodes = 2\n'
+    text += (
+        '[[loads]]\nat = "b:end"\nforce = [-1, 0, 0]\n\n[analysis]\ntype = "buckling"\nmodes = 2\n'
+    )
     results = _run(tmp_path, text)
     GA = 1e8
     euler = np.pi**2 * EI / (4 * L**2) * np.array([1, 4])  # EI_z = 4 EI_y
