@@ -52,19 +52,9 @@ def _vtu_array(parent, name, a, vtk_type):
     return e
 
 
-def write_vtu(path, fields, comm=MPI.COMM_WORLD):
-    """VTK XML UnstructuredGrid (ascii) of the polyline, VTK_LINE cells; rank 0 writes.
-
-    Args:
-        path: file name (".vtu").
-        fields: the dict of :func:`~beamfx.io.fields.nodal_fields` (ignored off rank 0).
-        comm: the communicator whose rank 0 writes.
-    """
-    if comm.rank != 0:
-        return
-    points = np.asarray(fields["X"]) + np.asarray(fields["u"])
-    cells = np.asarray(fields["cells"], dtype=np.int64)
-    arrays = _point_arrays(fields)
+def write_unstructured_vtu(path, points, cells, types, point_data):
+    """VTK XML UnstructuredGrid (ascii): ``cells`` a list of index arrays (any sizes) with VTK
+    ``types``, ``point_data`` a dict of arrays (``u`` marked as the vectors)."""
     root = ET.Element(
         "VTKFile",
         type="UnstructuredGrid",
@@ -79,16 +69,35 @@ def write_vtu(path, fields, comm=MPI.COMM_WORLD):
         NumberOfCells=str(len(cells)),
     )
     pd = ET.SubElement(piece, "PointData")
-    if "u" in arrays:
+    if "u" in point_data:
         pd.set("Vectors", "u")
-    for name, a in arrays.items():
+    for name, a in point_data.items():
+        a = np.asarray(a)
         _vtu_array(pd, name, a, "Int64" if a.dtype.kind in "iu" else "Float64")
-    _vtu_array(ET.SubElement(piece, "Points"), None, points, "Float64")
+    _vtu_array(ET.SubElement(piece, "Points"), None, np.asarray(points), "Float64")
     c = ET.SubElement(piece, "Cells")
-    _vtu_array(c, "connectivity", cells.ravel(), "Int64")
-    _vtu_array(c, "offsets", 2 * np.arange(1, len(cells) + 1), "Int64")
-    _vtu_array(c, "types", np.full(len(cells), VTK_LINE), "UInt8")
+    conn = np.concatenate(cells) if len(cells) else np.zeros(0, np.int64)
+    offsets = np.cumsum([len(x) for x in cells], dtype=np.int64)
+    _vtu_array(c, "connectivity", conn.astype(np.int64), "Int64")
+    _vtu_array(c, "offsets", offsets, "Int64")
+    _vtu_array(c, "types", np.asarray(types, np.uint8), "UInt8")
     _write_atomic(path, root)
+
+
+def write_vtu(path, fields, comm=MPI.COMM_WORLD):
+    """VTK XML UnstructuredGrid (ascii) of the polyline, VTK_LINE cells; rank 0 writes.
+
+    Args:
+        path: file name (".vtu").
+        fields: the dict of :func:`~beamfx.io.fields.nodal_fields` (ignored off rank 0).
+        comm: the communicator whose rank 0 writes.
+    """
+    if comm.rank != 0:
+        return
+    cells = np.asarray(fields["cells"], dtype=np.int64)
+    points = np.asarray(fields["X"]) + np.asarray(fields["u"])
+    types = np.full(len(cells), VTK_LINE)
+    write_unstructured_vtu(path, points, list(cells), types, _point_arrays(fields))
 
 
 class _Series:

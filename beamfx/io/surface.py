@@ -27,13 +27,12 @@ for tubes, VTK_QUAD rings) as end caps.
 """
 
 import os
-import xml.etree.ElementTree as ET
 
 import numpy as np
 from mpi4py import MPI
 
 from ._sections import lagrange_matrix
-from .paraview import PvdSeries, _vtu_array, _write_atomic
+from .paraview import PvdSeries, write_unstructured_vtu
 
 VTK_POLYGON, VTK_QUAD = 7, 9
 CIRCLE_SEGMENTS = 32
@@ -188,36 +187,6 @@ def surface_mesh(fields, degree, beam_names, outlines, subdivisions=4):
     return np.concatenate(points), cells, np.asarray(types, np.uint8), data
 
 
-def write_surface_vtu(path, points, cells, types, data):
-    """VTK XML UnstructuredGrid (ascii) of a polygon surface with point data."""
-    root = ET.Element(
-        "VTKFile",
-        type="UnstructuredGrid",
-        version="1.0",
-        byte_order="LittleEndian",
-        header_type="UInt64",
-    )
-    piece = ET.SubElement(
-        ET.SubElement(root, "UnstructuredGrid"),
-        "Piece",
-        NumberOfPoints=str(len(points)),
-        NumberOfCells=str(len(cells)),
-    )
-    pd = ET.SubElement(piece, "PointData")
-    if "u" in data:
-        pd.set("Vectors", "u")
-    for name, a in data.items():
-        _vtu_array(pd, name, a, "Int64" if a.dtype.kind in "iu" else "Float64")
-    _vtu_array(ET.SubElement(piece, "Points"), None, np.asarray(points), "Float64")
-    c = ET.SubElement(piece, "Cells")
-    conn = np.concatenate(cells) if cells else np.zeros(0, np.int64)
-    offsets = np.cumsum([len(x) for x in cells], dtype=np.int64)
-    _vtu_array(c, "connectivity", conn.astype(np.int64), "Int64")
-    _vtu_array(c, "offsets", offsets, "Int64")
-    _vtu_array(c, "types", np.asarray(types, np.uint8), "UInt8")
-    _write_atomic(path, root)
-
-
 class SurfaceSeries:
     """``surface.pvd`` and one ``surface_NNNN.vtu`` per step; rank 0 writes.
 
@@ -244,7 +213,7 @@ class SurfaceSeries:
         mesh = surface_mesh(fields, self.degree, self.beam_names, self.outlines, self.subdivisions)
         if len(mesh[0]) == 0:  # no beam has a drawable section (all "general")
             return
-        write_surface_vtu(vtu, *mesh)
+        write_unstructured_vtu(vtu, *mesh)
         self.pvd.add(time, vtu)
 
 
