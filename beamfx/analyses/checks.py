@@ -37,9 +37,8 @@ def closest_arc_length(curve, x, samples=400):
     return t, float(np.linalg.norm(curve.points([t])[0] - x))
 
 
-def joint_breaks(model, rtol=1e-8):
-    """(beam index, arc length) where the end of another beam meets a beam inside its span
-    (a T-joint): the mesh needs a vertex there for the joint to exist."""
+def end_contacts(model, rtol=1e-8):
+    """(i, j, s): the end of beam i lies on beam j at its arc length s (to rtol of the model)."""
     tol = rtol * _size(model)
     out = []
     for i, a in enumerate(model.beams):
@@ -47,14 +46,24 @@ def joint_breaks(model, rtol=1e-8):
             for j, b in enumerate(model.beams):
                 if j != i:
                     s, dist = closest_arc_length(b.curve, x)
-                    if dist < tol < s < b.curve.length - tol:
-                        out.append((j, s))
+                    if dist < tol:
+                        out.append((i, j, s))
     return out
+
+
+def joint_breaks(model, rtol=1e-8):
+    """(beam index, arc length) where the end of another beam meets a beam inside its span
+    (a T-joint): the mesh needs a vertex there for the joint to exist."""
+    tol = rtol * _size(model)
+    return [
+        (j, s)
+        for _, j, s in end_contacts(model, rtol)
+        if tol < s < model.beams[j].curve.length - tol
+    ]
 
 
 def connected_beams(model, rtol=1e-8):
     """Groups of beam indices joined by shared points (ends, T-joints), as sorted lists."""
-    tol = rtol * _size(model)
     group = list(range(len(model.beams)))
 
     def root(i):
@@ -62,11 +71,8 @@ def connected_beams(model, rtol=1e-8):
             i = group[i]
         return i
 
-    for i, a in enumerate(model.beams):
-        for x in a.curve.points([0.0, a.curve.length]):
-            for j, b in enumerate(model.beams):
-                if j != i and closest_arc_length(b.curve, x)[1] < tol:
-                    group[root(i)] = root(j)
+    for i, j, _ in end_contacts(model, rtol):
+        group[root(i)] = root(j)
     groups = {}
     for i in range(len(model.beams)):
         groups.setdefault(root(i), []).append(i)
@@ -81,9 +87,9 @@ def section_axes_at(beam, s):
     a, b = max(s - h, 0.0), min(s + h, L)
     t = np.diff(beam.curve.points([a, b]), axis=0)[0]
     t /= np.linalg.norm(t)
-    ref = beam.orientation
-    if ref is None:
-        ref = (1.0, 0.0, 0.0) if abs(t[2]) > 1 - 1e-8 else (0.0, 0.0, 1.0)
+    from .model import default_reference
+
+    ref = default_reference(t[None])[0] if beam.orientation is None else beam.orientation
     e3 = np.asarray(ref, float) - np.dot(ref, t) * t
     e3 /= np.linalg.norm(e3)
     e2 = np.cross(e3, t)

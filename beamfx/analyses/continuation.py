@@ -69,9 +69,11 @@ def point_displacement_dofs(model, at):
     return out
 
 
-def point_displacement(model, dofs):
-    """u at a point from :func:`point_displacement_dofs` (collective)."""
-    local = np.array([model.w.x.array[d].sum() for d in dofs])
+def point_displacement(model, dofs, values=None):
+    """u at a point from :func:`point_displacement_dofs` (collective), of ``model.w`` or of
+    another array of the same space (``values``)."""
+    values = model.w.x.array if values is None else values
+    local = np.array([values[d].sum() for d in dofs])
     count = np.array([len(d) for d in dofs], float)
     total = model.comm.allreduce(local, op=MPI.SUM)
     n = model.comm.allreduce(count, op=MPI.SUM)

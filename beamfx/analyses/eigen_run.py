@@ -7,35 +7,35 @@ from mpi4py import MPI
 from .continuation import point_displacement, point_displacement_dofs
 
 
-def _mode_report(model, scene, modes):
-    """Mode shapes at the probes: displacement, scaled so that its largest nodal value is 1."""
-    names = list(dict.fromkeys(scene.probes.values()))
-    dofs = {at: point_displacement_dofs(model, at) for at in names}
+def _normalise(model, modes):
+    """Scale each mode (in place) so that its largest nodal displacement is 1."""
     _, u_dofs = model.W.sub(0).collapse()
-    w0 = model.w.x.array.copy()
-    out = []
     for mode in modes:
-        peak = model.comm.allreduce(np.max(np.abs(mode.x.array[u_dofs]), initial=0.0), op=MPI.MAX)
-        model.w.x.array[:] = mode.x.array / (peak or 1.0)
-        out.append(
-            {
-                name: point_displacement(model, dofs[at]).tolist()
-                for name, at in scene.probes.items()
-            }
-        )
-    model.w.x.array[:] = w0
-    return out, w0
+        local = np.max(np.abs(mode.x.array[u_dofs]), initial=0.0)
+        peak = model.comm.allreduce(local, op=MPI.MAX)
+        mode.x.array[:] /= peak or 1.0
 
 
-def _write_modes(model, modes, write, w0):
-    """One ParaView step per mode (time = mode number): the state plus the mode, its largest
-    displacement scaled to a tenth of the model's size."""
-    _, u_dofs = model.W.sub(0).collapse()
+def _mode_report(model, scene, modes):
+    """Mode shapes (normalised) at the probes: their displacement."""
+    dofs = {at: point_displacement_dofs(model, at) for at in set(scene.probes.values())}
+    return [
+        {
+            name: point_displacement(model, dofs[at], mode.x.array).tolist()
+            for name, at in scene.probes.items()
+        }
+        for mode in modes
+    ]
+
+
+def _write_modes(model, modes, write):
+    """One ParaView step per mode (time = mode number): the state plus the (normalised) mode,
+    scaled to a tenth of the model's size."""
     x = model.mesh.mesh.geometry.x
     size = model.comm.allreduce(float(np.ptp(x, axis=0).max()) if len(x) else 0.0, op=MPI.MAX)
+    w0 = model.w.x.array.copy()
     for i, mode in enumerate(modes, start=1):
-        peak = model.comm.allreduce(np.max(np.abs(mode.x.array[u_dofs]), initial=0.0), op=MPI.MAX)
-        model.w.x.array[:] = w0 + 0.1 * size / (peak or 1.0) * mode.x.array
+        model.w.x.array[:] = w0 + 0.1 * size * mode.x.array
         model.w.x.scatter_forward()
         write(i, float(i))
     model.w.x.array[:] = w0
@@ -78,7 +78,8 @@ def run_eigen(model, scene, write, log):
         )
         for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
             log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s)")
-        shapes, w0 = _mode_report(model, scene, res.modes)
+        _normalise(model, res.modes)
+        shapes = _mode_report(model, scene, res.modes)
         extra = {
             "frequencies_hz": res.hz.tolist(),
             "omega_rad_s": res.omega.tolist(),
@@ -96,12 +97,13 @@ def run_eigen(model, scene, write, log):
         )
         for i, lam in enumerate(res.load_factors, start=1):
             log(f"  buckling mode {i}: load factor {lam:.8g}")
-        shapes, w0 = _mode_report(model, scene, res.modes)
+        _normalise(model, res.modes)
+        shapes = _mode_report(model, scene, res.modes)
         extra = {
             "load_factors": res.load_factors.tolist(),
             "about": settings["about"],
             "mode_shapes": shapes,
             "paraview_steps": "one per mode (time = mode number), displacement scaled to 1/10 of the model size",
         }
-    _write_modes(model, res.modes, write, w0)
+    _write_modes(model, res.modes, write)
     return SimpleNamespace(steps=tuple(steps), seconds=dict(res.seconds)), extra

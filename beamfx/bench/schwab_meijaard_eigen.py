@@ -189,6 +189,19 @@ L29 = P29["geometry"]["L"]
 W0_29 = np.pi**2 * np.sqrt(S29.EI_y / (S29.rho_A * L29**4))
 
 
+def pinned_in_tension(section, L, F, n, p):
+    """SM 2.9's beam: pinned-pinned (torsion held at the start), axial tip force F."""
+    return Model(
+        beams=(Beam("b", straight(L), section, n, p),),
+        supports=(
+            Support("b:start", ("ux", "uy", "uz", "rx")),
+            Support("b:end", ("uy", "uz")),
+        ),
+        point_loads=(PointLoad("b:end", (F, 0.0, 0.0)),),
+        kinematics=Kinematics(shear=False, stretch=False),
+    )
+
+
 def _prestressed(n, p):
     from ..analyses.modal import solve_modes
     from ..analyses.model import BeamModel
@@ -197,16 +210,7 @@ def _prestressed(n, p):
     ratios, its, dofs = {}, 0, 0
     for alpha in P29["alphas"]:
         F = alpha * np.pi**2 * S29.EI_y / L29**2
-        spec = Model(
-            beams=(Beam("b", straight(L29), S29, n, p),),
-            supports=(
-                Support("b:start", ("ux", "uy", "uz", "rx")),
-                Support("b:end", ("uy", "uz")),
-            ),
-            point_loads=(PointLoad("b:end", (F, 0.0, 0.0)),),
-            kinematics=Kinematics(shear=False, stretch=False),
-        )
-        model = BeamModel(spec)
+        model = BeamModel(pinned_in_tension(S29, L29, F, n, p))
         its += solve_static(model, steps=1, prefix="beamfx_bench_static_").newton_iterations
         r = solve_modes(model, 1, rotary="polar", prefix="beamfx_bench_modal_")
         ratios[f"alpha={alpha:g}"] = r.omega[0] / (W0_29 * np.sqrt(1 + alpha))
