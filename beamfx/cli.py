@@ -12,6 +12,11 @@ def main(argv=None):
     p = sub.add_parser("run", help="solve a scene (the built-in 45-degree bend if none is given)")
     p.add_argument("scene", nargs="?")
     p.add_argument("--out", help="output folder (default: the scene's [output] dir)")
+    p.add_argument(
+        "--restart",
+        action="store_true",
+        help="transient: go on from the last checkpoint in the output folder",
+    )
     p = sub.add_parser("check", help="validate a scene file without solving")
     p.add_argument("scene")
     p = sub.add_parser("bench", help="run the benchmark cases and write a report")
@@ -26,7 +31,7 @@ def main(argv=None):
         if args.command == "run":
             from .runner import run_scene
 
-            run_scene(args.scene, args.out)
+            run_scene(args.scene, args.out, restart=args.restart)
         elif args.command == "check":
             from .runner import check_scene
 

@@ -13,7 +13,7 @@ def default_scene_path():
     return Path(str(resources.files("beamfx") / "scenes" / DEFAULT_SCENE))
 
 
-def run_scene(path=None, out_dir=None, log=None):
+def run_scene(path=None, out_dir=None, log=None, restart=False):
     """Solve the scene at ``path`` (built-in default if None); return the results dict.
 
     Writes ``results.json`` only after success (a stale one is removed first), and the
@@ -80,6 +80,13 @@ def run_scene(path=None, out_dir=None, log=None):
         xdmf.add(time, fields)
         surface.add(step, time, fields)
 
+    def resume(t):
+        """Keep the ParaView frames of a restarted run up to time ``t``."""
+        for series in (pvd, xdmf, surface.pvd):
+            series.resume(t)
+
+    write.resume = resume
+
     def on_step(step):
         write(step.step, step.load_factor)
         values = evaluate_points(model, list(scene.probes.values()))
@@ -96,6 +103,17 @@ def run_scene(path=None, out_dir=None, log=None):
             latest["probes"] = track_rotations(
                 None, evaluate_points(model, list(scene.probes.values()))
             )
+    elif scene.analysis == "transient":
+        from .analyses.transient_run import run_transient
+
+        result, extra, latest["probes"] = run_transient(model, scene, out, write, log, restart)
+    elif scene.analysis == "rotating":
+        from .analyses.rotating_run import run_rotating
+
+        result, extra = run_rotating(model, scene, write, log, out)
+        latest["probes"] = track_rotations(
+            None, evaluate_points(model, list(scene.probes.values()))
+        )
     else:
         result = solve_static(
             model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
@@ -123,6 +141,7 @@ def run_scene(path=None, out_dir=None, log=None):
                 "cutbacks": s.cutbacks,
             }
             for s in result.steps
+            if hasattr(s, "load_factor")
         ],
         "newton_iterations": int(sum(s.iterations for s in result.steps)),
         **extra,

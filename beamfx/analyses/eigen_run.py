@@ -55,10 +55,10 @@ def run_eigen(model, scene, write, log):
     steps = ()
     if scene.analysis == "modal":
         mass = model.comm.allreduce(float(np.max(model.inertia.x.array, initial=0.0)), op=MPI.MAX)
-        if mass <= 0:
+        if mass <= 0 and not scene.model.point_masses:
             raise ValueError(
                 f"{scene.file}: a modal analysis needs mass: give [material] rho, or rho_A and "
-                "rho_I of the general sections"
+                "rho_I of the general sections, or [[masses]]"
             )
         loaded = (
             scene.model.point_loads or scene.model.distributed_loads or any(scene.model.gravity)

@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 import ufl
 
-from ..physics.inertia import mass_form
+from ..physics.inertia import mass_form, point_mass_form
 from ..solvers.eigen import solve_eigen
 from ..solvers.forms import compile_form
 
@@ -27,11 +27,15 @@ class ModalResult(NamedTuple):
 
 
 def mass_ufl(model, rotary="full"):
-    """The mass form of ``model`` about its current state (UFL)."""
+    """The mass form of ``model`` about its current state (UFL): the beams' and the point
+    masses' (``rotary`` applies to the sections only; a point mass keeps its inertia)."""
     v = ufl.split(ufl.TestFunction(model.W))
     dw = ufl.split(ufl.TrialFunction(model.W))
     rot = ufl.split(model.w)[1]
-    return mass_form(model.kin, rot, v, dw, model.inertia, model.Lam0, model.dx, rotary)
+    m = mass_form(model.kin, rot, v, dw, model.inertia, model.Lam0, model.dx, rotary)
+    return m + model.point_mass_terms(
+        lambda pm: point_mass_form(model.kin, rot, v, dw, pm.mass, pm.inertia)
+    )
 
 
 def assemble_pair(a, b, bcs):

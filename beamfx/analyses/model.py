@@ -71,10 +71,10 @@ class BeamModel:
         self.degree = p = max(b.degree for b in model.beams)
         self.raised_degree = [b.name for b in model.beams if b.degree < p]
 
-        # named points: every 'at' of supports, loads, springs and probes becomes a vertex
-        ats = [x.at for x in (*model.supports, *model.point_loads, *model.springs)] + list(
-            extra_points
-        )
+        # named points: every 'at' of supports, loads, springs, masses and probes becomes a vertex
+        ats = [
+            x.at for x in (*model.supports, *model.point_loads, *model.springs, *model.point_masses)
+        ] + list(extra_points)
         self.named = {at: resolve_point(model, at) for at in dict.fromkeys(ats)}
         breaks = {i: [] for i in range(len(model.beams))}
         for b, s, _ in self.named.values():
@@ -122,6 +122,7 @@ class BeamModel:
         self.C_M = ufl.diag(ufl.as_vector([C[3], C[4], C[5]]))
 
         self.load_factor = fem.Constant(m, PETSc.ScalarType(0.0))
+        self.time, self._load_histories = 0.0, []
         self._build_forms()
         self.bcs, self._bc_values = self._build_supports()
 
@@ -203,6 +204,12 @@ class BeamModel:
         dP, side = self.point_measure(at)
         return (integrand(side) if side else integrand) * dP
 
+    def point_mass_terms(self, integrand):
+        """Σ over the scene's point masses of ``integrand(point_mass)`` (UFL) at its point; 0 if
+        there are none. E.g. the mass form with :func:`~beamfx.physics.inertia.point_mass_form`,
+        or the kinetic energy with :func:`~beamfx.physics.inertia.point_kinetic_energy`."""
+        return sum((self._at_point(pm.at, integrand(pm)) for pm in self.spec.point_masses), start=0)
+
     def _build_forms(self):
         spec, kin = self.spec, self.kin
         u, rot = ufl.split(self.w)
@@ -228,24 +235,37 @@ class BeamModel:
 
         def work_of(load):
             return energy.load_work(
-                kin, rot, v_u, v_rot, vec(load.force), vec(load.moment), load.kind
+                kin, rot, v_u, v_rot, vec(load.force), vec(load.moment), load.kind, load.arm
             )
 
         work = 0
         for ld in spec.point_loads:
-            work += self._at_point(ld.at, work_of(ld))
+            work += self._history_factor(ld) * self._at_point(ld.at, work_of(ld))
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
             on_beam = 1.0 if dl.beam is None else self._beam_indicator(names.index(dl.beam))
-            work += on_beam * work_of(dl) * self.dx
+            work += self._history_factor(dl) * on_beam * work_of(dl) * self.dx
         if any(spec.gravity):
             rho_A = self.inertia[0]
             work += rho_A * ufl.dot(vec(spec.gravity), displacement(kin, v_u)) * self.dx
         self.Pi = Pi
         self.F = ufl.derivative(Pi, self.w, test)
+        self.work = None  # virtual work of the loads at load factor 1 (None: no loads)
         if work != 0:
+            self.work = work
             self.F -= self.load_factor * work
         self.J = ufl.derivative(self.F, self.w, ufl.TrialFunction(self.W))
+
+    def _history_factor(self, load):
+        """1, or a constant that :meth:`set_time` sets to the load's history f(t)."""
+        from dolfinx import fem
+        from petsc4py import PETSc
+
+        if load.history is None:
+            return 1.0
+        c = fem.Constant(self.mesh.mesh, PETSc.ScalarType(load.history(0.0)))
+        self._load_histories.append((c, load.history))
+        return c
 
     def _local_support_penalty(self, sup, u3, rot):
         """Stiff springs on the fixed dofs in the section axes Λ0 at the point (values scaled by
@@ -297,7 +317,7 @@ class BeamModel:
                 dofs = fem.locate_dofs_topological(V, 0, verts)
                 c = fem.Constant(m, PETSc.ScalarType(value(0.0)))
                 bcs.append(fem.dirichletbc(c, dofs, V))
-                values.append((c, value))
+                values.append((c, value, sup.history))
         return bcs, values
 
     def _support_targets(self, sup):
@@ -349,8 +369,16 @@ class BeamModel:
     def set_load_factor(self, lam):
         """Scale loads and prescribed values (a prescribed rotation turns by lam times its angle)."""
         self.load_factor.value = lam
-        for c, value in self._bc_values:
-            c.value = value(lam)
+        for c, value, history in self._bc_values:
+            c.value = value(lam * (1.0 if history is None else float(history(self.time))))
+
+    def set_time(self, t):
+        """Time of a transient: loads and supports with a history take their values at ``t``
+        (times the load factor, which a transient keeps at 1)."""
+        self.time = t
+        for c, history in self._load_histories:
+            c.value = float(history(t))
+        self.set_load_factor(float(self.load_factor.value))
 
     def unknowns(self):
         """Global number of unknowns."""

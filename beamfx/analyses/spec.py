@@ -22,7 +22,7 @@ class Beam:
 
 
 AXES = ("global", "local")
-LOAD_KINDS = ("dead", "follower", "semitangential")
+LOAD_KINDS = ("dead", "follower", "semitangential", "quasitangential")
 
 
 @dataclass(frozen=True)
@@ -42,17 +42,21 @@ class Support:
     displacement: tuple = (0.0, 0.0, 0.0)
     rotation: tuple = (0.0, 0.0, 0.0)
     axes: str = "global"
+    history: object = None  # f(t) scaling displacement and rotation in a transient (None: 1)
 
 
 @dataclass(frozen=True)
 class PointLoad:
     """Force and moment at a point; ``kind`` one of :data:`LOAD_KINDS` (see
-    :func:`beamfx.physics.energy.moment_work`)."""
+    :func:`beamfx.physics.energy.moment_work`); ``arm`` the direction of the arm of a
+    "quasitangential" moment (global axes, normal to the moment)."""
 
     at: str
     force: tuple = (0.0, 0.0, 0.0)
     moment: tuple = (0.0, 0.0, 0.0)
     kind: str = "dead"
+    history: object = None  # f(t) scaling force and moment in a transient (None: 1)
+    arm: tuple | None = None
 
     @property
     def follower(self):
@@ -61,12 +65,15 @@ class PointLoad:
 
 @dataclass(frozen=True)
 class DistributedLoad:
-    """Force and moment per unit reference length on ``beam`` (all beams if None)."""
+    """Force and moment per unit reference length on ``beam`` (all beams if None); ``kind``
+    and ``arm`` as in :class:`PointLoad`."""
 
     beam: str | None = None
     force: tuple = (0.0, 0.0, 0.0)
     moment: tuple = (0.0, 0.0, 0.0)
     kind: str = "dead"
+    history: object = None  # f(t) scaling force and moment in a transient (None: 1)
+    arm: tuple | None = None
 
     @property
     def follower(self):
@@ -84,6 +91,16 @@ class Spring:
 
 
 @dataclass(frozen=True)
+class PointMass:
+    """A rigid body attached at a point: ``mass`` and the rotary inertia ``inertia`` about the
+    point (3x3, global axes in the reference state; it turns with the section)."""
+
+    at: str
+    mass: float = 0.0
+    inertia: tuple = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
+@dataclass(frozen=True)
 class Model:
     beams: tuple
     supports: tuple = ()
@@ -92,6 +109,7 @@ class Model:
     springs: tuple = ()
     gravity: tuple = (0.0, 0.0, 0.0)
     kinematics: Kinematics = field(default_factory=Kinematics)
+    point_masses: tuple = ()
 
     def beam(self, name):
         for b in self.beams:

@@ -61,6 +61,14 @@ def register(case):
 
 def all_cases():
     """Import every paper module (they register their cases) and return the registry."""
-    from . import classic, howcroft_2016, schwab_meijaard_2009, schwab_meijaard_eigen  # noqa: F401
+    from . import (  # noqa: F401
+        classic,
+        howcroft_2016,
+        schwab_meijaard_2009,
+        schwab_meijaard_eigen,
+        schwab_meijaard_rotating,
+        schwab_meijaard_torque,
+        transient,
+    )
 
     return REGISTRY

@@ -59,6 +59,11 @@ def rates(rows):
     """Observed convergence order between successive element doublings of the same degree."""
     out = []
     for a, b in pairwise(rows):
+        if "dt" in a and "dt" in b and a["elements"] == b["elements"]:  # order in time
+            if abs(b["dt"] - a["dt"] / 2) < 1e-12 * a["dt"] and a["error"] > 0 < b["error"]:
+                rate = float(np.log2(a["error"] / b["error"]))
+                out.append({"degree": a["degree"], "dt": b["dt"], "rate": rate})
+            continue
         if (
             a["degree"] == b["degree"]
             and b["elements"] == 2 * a["elements"]
@@ -94,13 +99,20 @@ def criterion_1mm(rows):
 
 def run_case(case, log=print):
     rows = []
-    for n, p in case.settings:
-        row = case.run_setting(n, p) if hasattr(case, "run_setting") else run_setting(case, n, p)
+    for setting in case.settings:  # (elements, degree) or, for transients, (…, dt)
+        n, p = setting[:2]
+        row = (
+            case.run_setting(*setting)
+            if hasattr(case, "run_setting")
+            else run_setting(case, n, p)
+        )
         rows.append(row)
         if log:
+            dt = f", dt {row['dt']:g}" if "dt" in row else ""
             log(
-                f"  {case.id}: {n} x P{p}, {row['unknowns']} unknowns, {row['newton_iterations']} "
-                f"Newton its, cold {row['wall_s_cold']:.2f} s, warm {row['wall_s_warm']:.3f} s"
+                f"  {case.id}: {n} x P{p}{dt}, {row['unknowns']} unknowns, "
+                f"{row['newton_iterations']} Newton its, cold {row['wall_s_cold']:.2f} s, "
+                f"warm {row['wall_s_warm']:.3f} s"
             )
     ref_is_finest = case.reference is None
     ref = rows[-1]["values"] if ref_is_finest else case.reference
@@ -179,8 +191,9 @@ def markdown(results):
             "|---|---|---|---|---|---|" + "---|" * len(r["reference"]),
         ]
         for row in r["rows"]:
+            dt = f", dt = {row['dt']:g}" if "dt" in row else ""
             lines.append(
-                f"| {row['elements']} x P{row['degree']} | {row['unknowns']} | {row['newton_iterations']} | "
+                f"| {row['elements']} x P{row['degree']}{dt} | {row['unknowns']} | {row['newton_iterations']} | "
                 f"{row['wall_s_cold']:.2f} | {row['wall_s_warm']:.3f} | {row['error']:.2e} | "
                 + " | ".join(f"{row['values'][k]:.8g}" for k in r["reference"])
                 + " |"
@@ -201,7 +214,12 @@ def markdown(results):
                 "",
                 "Observed order: "
                 + ", ".join(
-                    f"P{x['degree']} at {x['elements']} el: {x['rate']:.2f}" for x in r["rates"]
+                    (
+                        f"in time at dt = {x['dt']:g}: {x['rate']:.2f}"
+                        if "dt" in x
+                        else f"P{x['degree']} at {x['elements']} el: {x['rate']:.2f}"
+                    )
+                    for x in r["rates"]
                 ),
             ]
         if "criterion_1mm" in r:

@@ -6,8 +6,8 @@ pre-stress), so the models are run in that limit. Eigenfrequencies: the shear-ri
 2.9 inextensible) kinematics, whose penalty 1e8 EI/L^2 leaves ~3e-8, and no bending rotary
 inertia (``rotary="polar"``). Buckling: that penalty costs the non-symmetric buckling solve
 its accuracy through conditioning (a 1e-5..1e-4 noise floor), so shear and extension are made
-``STIFF`` = 100 times stiffer instead (error P/(100 GA) ~ 6e-7 for 2.5). Not here: 2.7
-(torque buckling) and 2.10 (rotating beam).
+``STIFF`` = 100 times stiffer instead (error P/(100 GA) ~ 6e-7 for 2.5). 2.7 (torque
+buckling) is in :mod:`.schwab_meijaard_torque`; not here: 2.10 (rotating beam).
 """
 
 import time

@@ -1,6 +1,7 @@
 """Rank-0 logging and a one-line progress display."""
 
 import sys
+import time
 
 from mpi4py import MPI
 
@@ -23,17 +24,26 @@ class Progress:
         comm: the communicator whose rank 0 prints.
     """
 
-    def __init__(self, total=None, label="", stream=None, comm=MPI.COMM_WORLD):
+    def __init__(self, total=None, label="", stream=None, comm=MPI.COMM_WORLD, every=None):
         self.total, self.label = total, label
         self.stream = stream or sys.stdout
         self.active = comm.rank == 0
         self.tty = self.active and hasattr(self.stream, "isatty") and self.stream.isatty()
         self._width = 0
+        self.every = every  # seconds between lines (None: every update)
+        self._last = None
 
     def update(self, done, text=""):
-        """Report ``done`` units finished, with an optional note (e.g. "λ = 0.5, 4 its")."""
+        """Report ``done`` units finished, with an optional note (e.g. "λ = 0.5, 4 its").
+
+        With ``every`` set, updates closer than that many seconds to the last one shown are
+        skipped (a time stepper may take thousands of steps)."""
         if not self.active:
             return
+        now = time.monotonic()
+        if self.every and self._last is not None and now - self._last < self.every:
+            return
+        self._last = now
         count = f"{done}/{self.total}" if self.total else f"{done}"
         line = " ".join(p for p in (self.label, count, text) if p)
         if self.tty:

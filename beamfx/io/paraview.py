@@ -110,6 +110,14 @@ class _Series:
         self.entries.append(entry)
         _write_atomic(self.path, self._tree())
 
+    def resume(self, t_max):
+        """Keep the entries of an existing file up to time ``t_max`` (a restarted run)."""
+        if self.comm.rank != 0 or not os.path.exists(self.path):
+            return
+        self.entries = [e for e in self._read(ET.parse(self.path).getroot()) if e[0] <= t_max]
+        self.entries = [e[1] for e in self.entries]
+        _write_atomic(self.path, self._tree())
+
 
 class PvdSeries(_Series):
     """ParaView collection of .vtu files, one per time (or load factor), rewritten on each add.
@@ -124,6 +132,13 @@ class PvdSeries(_Series):
         if self.comm.rank == 0:
             folder = os.path.dirname(os.path.abspath(self.path))
             self._append((float(time), os.path.relpath(os.fspath(vtu_path), folder)))
+
+    @staticmethod
+    def _read(root):
+        return [
+            (float(e.get("timestep")), (float(e.get("timestep")), e.get("file")))
+            for e in root.iter("DataSet")
+        ]
 
     def _tree(self):
         root = ET.Element("VTKFile", type="Collection", version="1.0", byte_order="LittleEndian")
@@ -175,6 +190,11 @@ class XdmfSeries(_Series):
             att = ET.SubElement(grid, "Attribute", Name=name, AttributeType=kind, Center="Node")
             _xdmf_item(att, a, "Int" if a.dtype.kind in "iu" else "Float")
         self._append(grid)
+
+    @staticmethod
+    def _read(root):
+        series = root.find("Domain").find("Grid")
+        return [(float(g.find("Time").get("Value")), g) for g in series.findall("Grid")]
 
     def _tree(self):
         root = ET.Element("Xdmf", Version="3.0")

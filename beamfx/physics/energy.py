@@ -31,7 +31,7 @@ def force_work(kin, rot, v_u, force, follower):
     return ufl.dot(f, displacement(kin, v_u))
 
 
-def moment_work(kin, rot, v_rot, moment, kind):
+def moment_work(kin, rot, v_rot, moment, kind, arm=None):
     """Virtual work of a moment of ``kind``:
 
     * "dead": M·δθ, fixed in space (global axes). Not conservative for finite 3D rotations;
@@ -40,11 +40,23 @@ def moment_work(kin, rot, v_rot, moment, kind):
     * "semitangential": M0·δψ, work-conjugate to the rotation vector ψ (Argyris et al. 1979):
       conservative, with potential −M0·ψ; to first order the moment vector turns by half the
       rotation, M ≈ M0 + ½ ψ × M0.
+    * "quasitangential": the couple of two dead forces ±F at the ends of a rigid arm ``arm``
+      (a, global axes in the reference state, normal to M0) that turns with the section
+      (Argyris et al. 1979; Ziegler 1977): M = (R a) × F with F = M0 × a/|a|², potential
+      −F·(R a), conservative. To first order M ≈ M0 + |M0| â (ψ·F̂): the moment turns only
+      with the rotation about the force direction F̂. The two couples with arms â and F̂ have
+      the mean potential −M0·ψ + O(ψ³), the semitangential moment.
     """
     if kind == "follower":
         return ufl.dot(moment, body_virtual_rotation(kin, rot, v_rot))
     if kind == "semitangential":
         return ufl.derivative(ufl.dot(moment, rotation_vector(kin, rot)), rot, v_rot)
+    if kind == "quasitangential":
+        if arm is None:
+            raise ValueError("a quasitangential moment needs the direction of its arm")
+        a = ufl.as_vector([float(c) for c in arm])
+        force = ufl.cross(moment, a) / ufl.dot(a, a)
+        return ufl.derivative(ufl.dot(force, section_rotation(kin, rot) * a), rot, v_rot)
     return ufl.dot(moment, spatial_virtual_rotation(kin, rot, v_rot))
 
 
@@ -63,9 +75,17 @@ def constraint_penalty(values, targets, k):
     return 0.5 * k * sum((v - t) ** 2 for v, t in zip(values, targets))
 
 
-def load_work(kin, rot, v_u, v_rot, force, moment, kind):
-    """Virtual work of a force and a moment; ``kind`` as in :func:`moment_work` (a force of
-    kind "semitangential" is dead)."""
+def load_work(kin, rot, v_u, v_rot, force, moment, kind, arm=None):
+    """Virtual work of a force and a moment; ``kind`` and ``arm`` as in :func:`moment_work` (a
+    force of kind "semitangential" or "quasitangential" is dead)."""
     return force_work(kin, rot, v_u, force, kind == "follower") + moment_work(
-        kin, rot, v_rot, moment, kind
+        kin, rot, v_rot, moment, kind, arm
     )
+
+
+def strain_rate_dissipation(Gamma_dot, K_dot, C_N, C_M, eta, dx_shear, dx_bend):
+    r"""Rayleigh dissipation potential of stiffness-proportional damping,
+    D = ½ η (Γ̇·C_N Γ̇ + K̇·C_M K̇): the viscous stresses η C Γ̇ of a Kelvin–Voigt material with
+    relaxation time η. Built on strain rates, it is objective: a rigid motion dissipates
+    nothing (unlike η K_T q̇, which damps a spinning beam)."""
+    return strain_energy(Gamma_dot, K_dot, eta * C_N, eta * C_M, dx_shear, dx_bend)

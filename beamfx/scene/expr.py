@@ -1,7 +1,7 @@
 """Functions of one variable written in a scene: a number, an expression string or a table.
 
 ``"0.02 * (1 - 0.5 * s / L)"`` (names: the variable, the constants given by the caller, pi and
-e, and the functions below) or ``{ s = [0, 1], values = [0.02, 0.01] }`` (piecewise linear,
+e, and the functions below; comparisons give 0 or 1, and ``where(t < 15, a, b)`` picks) or ``{ s = [0, 1], values = [0.02, 0.01] }`` (piecewise linear,
 constant beyond the ends). Expressions are checked with :mod:`ast` before use: only
 arithmetic, calls of the listed functions and the listed names are allowed.
 """
@@ -15,11 +15,12 @@ FUNCTIONS = {
     name: getattr(np, name)
     for name in ("sin", "cos", "tan", "exp", "log", "sqrt", "abs", "arctan", "tanh", "cosh", "sinh")
 }
-FUNCTIONS.update(min=np.minimum, max=np.maximum)
+FUNCTIONS.update(min=np.minimum, max=np.maximum, where=np.where)
 CONSTANTS = {"pi": math.pi, "e": math.e}
 _NODES = (
     ast.Expression, ast.BinOp, ast.UnaryOp, ast.Call, ast.Name, ast.Load, ast.Constant,
     ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd, ast.Mod,
+    ast.Compare, ast.Lt, ast.LtE, ast.Gt, ast.GtE,
 )  # fmt: skip
 
 

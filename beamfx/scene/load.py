@@ -7,6 +7,7 @@ The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, `
 import tomllib
 from dataclasses import dataclass, field
 from functools import partial
+from numbers import Real
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from ..analyses.spec import (
     DistributedLoad,
     Model,
     PointLoad,
+    PointMass,
     Spring,
     Support,
 )
@@ -30,7 +32,7 @@ from .table import SceneError, Table
 
 CURVE_SHAPES = ("line", "arc", "helix", "polyline", "spline", "gmsh")
 SECTION_TYPES = ("rectangle", "circle", "tube", "general")
-ANALYSES = ("static", "linear_static", "arclength", "modal", "buckling")
+ANALYSES = ("static", "linear_static", "arclength", "modal", "buckling", "transient", "rotating")
 FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
 
 
@@ -123,6 +125,90 @@ def _along(t, key, length, default=..., positive=True):
             )
         return f
     return t.get(key, float, default, positive=positive)
+
+
+def _history(t, key="history"):
+    """A function of time: a number, an expression of ``t`` or a table
+    ``{ t = [...], values = [...] }`` (piecewise linear, constant beyond its ends); None if
+    the key is absent."""
+    if not t.has(key):
+        return None
+    raw = t.data.get(key)
+    t.used.add(key)
+    try:
+        if isinstance(raw, bool):
+            raise ValueError(f"{raw!r} is not a number")
+        if isinstance(raw, (int, float)):
+            value = float(raw)
+            f = partial(np.full_like, fill_value=value, dtype=float)
+            f.text = str(value)
+        elif isinstance(raw, str):
+            f = compile_expression(raw, "t")
+        elif isinstance(raw, dict):
+            sub = Table(raw, t.path + "." + key, t.file)
+            f = table_function(sub.get("t", list), sub.get("values", list))
+            sub.done()
+        else:
+            raise ValueError(f"{raw!r} is not a number, expression or table")
+        values = f(np.linspace(0.0, 1.0, 11))
+        if not np.all(np.isfinite(values)):
+            raise ValueError("it is not finite on [0, 1]")
+    except (ValueError, TypeError, ZeroDivisionError, FloatingPointError) as e:
+        t.fail(
+            key, f"{e} (write a number, an expression of t, or {{ t = [...], values = [...] }})"
+        )
+    return f
+
+
+def _arm(t, kind, moment_key):
+    """The arm of a quasitangential moment (required for that kind, refused for the others)."""
+    if kind != "quasitangential":
+        if t.has("arm"):
+            t.fail("arm", f"only a kind = 'quasitangential' moment has an arm, not {kind!r}")
+        return None
+    arm = np.asarray(t.get("arm", "vec3"))
+    moment = np.asarray(t.get(moment_key, "vec3", (0.0,) * 3))
+    norm = np.linalg.norm(arm)
+    if norm == 0 or abs(arm @ moment) > 1e-9 * norm * np.linalg.norm(moment):
+        t.fail("arm", f"must be a non-zero vector normal to '{moment_key}', got {list(arm)}")
+    return tuple(arm)
+
+
+def _point_mass(t):
+    """A ``[[masses]]`` table: ``at``, ``mass`` and ``inertia`` ([Jxx, Jyy, Jzz] or 3x3)."""
+    at = t.get("at", str)
+    mass = t.get("mass", float, 0.0)
+    if mass < 0:
+        t.fail("mass", f"must not be negative, got {mass}")
+    J = np.zeros((3, 3))
+    if t.has("inertia"):
+        raw = t.get("inertia", list)
+
+        def numbers(row):
+            return (
+                isinstance(row, list)
+                and len(row) == 3
+                and all(isinstance(x, Real) and not isinstance(x, bool) for x in row)
+            )
+
+        if numbers(raw):
+            J = np.diag(np.array(raw, float))
+        elif len(raw) == 3 and all(numbers(row) for row in raw):
+            J = np.array(raw, float)
+        else:
+            t.fail("inertia", f"expected [Jxx, Jyy, Jzz] or a 3x3 list of numbers, got {raw!r}")
+        scale = np.abs(J).max()
+        if np.abs(J - J.T).max() > 1e-12 * scale:
+            t.fail("inertia", "must be symmetric")
+        smallest = np.linalg.eigvalsh(J).min()
+        if smallest < -1e-12 * scale:
+            t.fail(
+                "inertia",
+                f"must be positive semi-definite; its smallest eigenvalue is {smallest:g}",
+            )
+    if mass == 0 and not J.any():
+        t.fail("mass", "give a positive 'mass' and/or a non-zero 'inertia'")
+    return PointMass(at, mass, tuple(tuple(float(x) for x in row) for row in J))
 
 
 def _section(t, mat, length):
@@ -235,6 +321,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             t.get("displacement", "vec3", (0.0,) * 3),
             t.get("rotation", "vec3", (0.0,) * 3),
             t.get("axes", str, "global", choices=AXES),
+            _history(t),
         )
         free = [
             DOF_NAMES[i] for i in range(3) if sup.displacement[i] and DOF_NAMES[i] not in sup.fix
@@ -261,6 +348,8 @@ def parse_scene(data, file="<scene>", base=Path(".")):
                     t.get("force", "vec3", (0.0,) * 3),
                     t.get("moment", "vec3", (0.0,) * 3),
                     kind,
+                    _history(t),
+                    arm=_arm(t, kind, "moment"),
                 )
             )
         else:
@@ -270,6 +359,8 @@ def parse_scene(data, file="<scene>", base=Path(".")):
                     t.get("force_per_length", "vec3", (0.0,) * 3),
                     t.get("moment_per_length", "vec3", (0.0,) * 3),
                     kind,
+                    _history(t),
+                    arm=_arm(t, kind, "moment_per_length"),
                 )
             )
         t.done(
@@ -286,6 +377,10 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             t.fail("stiffness", "give non-negative 'stiffness' and/or 'rotational', not all zero")
         springs.append(sp)
         t.done()
+    masses = []
+    for t in top.tables("masses"):
+        masses.append(_point_mass(t))
+        t.done()
 
     mt = top.table("model", {})
     kin = Kinematics(
@@ -301,6 +396,10 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     settings = _continuation(at) if analysis == "arclength" else {}
     if analysis in ("modal", "buckling"):
         settings = _eigen(at, analysis)
+    if analysis == "transient":
+        settings = _transient(at)
+    if analysis == "rotating":
+        settings = _rotating(at, Model(tuple(beams), tuple(supports)))
     at.done()
     if analysis == "linear_static":
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
@@ -326,6 +425,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         tuple(springs),
         gravity,
         kin,
+        point_masses=tuple(masses),
     )
     _check_points(model, probes, file)
     _check_model(model, file)
@@ -370,6 +470,67 @@ def _eigen(t, analysis):
     return out
 
 
+def _rotating(t, model):
+    """Settings of a rotating ``[analysis]``: spin axis, hub point, speeds (rad/s), modes."""
+    from ..analyses.spec import resolve_point
+
+    out = {
+        "axis": t.get("axis", "vec3", (0.0, 0.0, 1.0)),
+        "hub": t.get("hub", str, model.supports[0].at if model.supports else None),
+        "modes": t.get("modes", int, 6, positive=True),
+        "rotary_inertia": t.get("rotary_inertia", str, "full", choices=("full", "none")),
+    }
+    if not any(out["axis"]):
+        t.fail("axis", "must not be zero")
+    if out["hub"] is None:
+        t.fail("hub", "give the hub point (there is no support to default to)")
+    try:
+        resolve_point(model, out["hub"])
+    except ValueError as e:
+        t.fail("hub", str(e))
+    if t.has("speeds_rad_s") == t.has("speed_rad_s"):
+        t.fail("speeds_rad_s", "give either speeds_rad_s = [...] or speed_rad_s = a number")
+    if t.has("speed_rad_s"):
+        out["speeds_rad_s"] = (t.get("speed_rad_s", float),)
+    else:
+        speeds = t.get("speeds_rad_s", list)
+        if not speeds or not all(isinstance(x, Real) and not isinstance(x, bool) for x in speeds):
+            t.fail("speeds_rad_s", f"expected a non-empty list of numbers, got {speeds!r}")
+        out["speeds_rad_s"] = tuple(float(x) for x in speeds)
+    return out
+
+
+def _transient(t):
+    """Settings of a transient ``[analysis]``: a TransientSettings and the start."""
+    from ..analyses.transient import SCHEMES, TransientSettings
+
+    t_end = t.get("t_end", float, positive=True)
+    dt = t.get("dt", float, positive=True)
+    damping = t.table("damping", {})
+    settings = TransientSettings(
+        t_end=t_end,
+        dt=dt,
+        scheme=t.get("scheme", str, "generalized_alpha", choices=SCHEMES),
+        rho_inf=t.get("rho_inf", float, 0.9),
+        hht_alpha=t.get("hht_alpha", float, 0.05),
+        dt_min=t.get("dt_min", float, dt / 1000, positive=True),
+        damping_mass=damping.get("mass", float, 0.0),
+        damping_stiffness=damping.get("stiffness", float, 0.0),
+        rotary_inertia=t.get("rotary_inertia", str, "full", choices=("full", "polar", "none")),
+        output_every=t.get("output_every", int, max(1, round(t_end / dt / 200)), positive=True),
+        checkpoint_every=t.get("checkpoint_every", int, 50),
+    )
+    damping.done()
+    if not 0.0 <= settings.rho_inf <= 1.0:
+        t.fail("rho_inf", f"must lie in [0, 1], got {settings.rho_inf}")
+    if not 0.0 <= settings.hht_alpha <= 1 / 3:
+        t.fail("hht_alpha", f"must lie in [0, 1/3], got {settings.hht_alpha}")
+    if min(settings.damping_mass, settings.damping_stiffness) < 0:
+        t.fail("damping", "mass and stiffness coefficients must be non-negative")
+    start = t.get("start", str, "rest", choices=("rest", "static"))
+    return {"transient": settings, "start": start}
+
+
 def _check_model(model, file):
     """Checks that need the whole model: the planar model's plane, prescribed rotations."""
     from ..analyses.checks import check_planar
@@ -393,6 +554,7 @@ def _check_points(model, probes, file):
     named = [(f"supports[{i}].at", s.at) for i, s in enumerate(model.supports)]
     named += [(f"loads.at ({p.at})", p.at) for p in model.point_loads]
     named += [(f"springs[{i}].at", s.at) for i, s in enumerate(model.springs)]
+    named += [(f"masses[{i}].at", m.at) for i, m in enumerate(model.point_masses)]
     named += [(f"probes.{k}.at", v) for k, v in probes.items()]
     for where, at in named:
         try:

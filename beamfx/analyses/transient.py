@@ -1,0 +1,433 @@
+r"""Transient dynamics: the Lagrange equations of the beam stepped in time.
+
+The kinetic energy :func:`~beamfx.physics.inertia.kinetic_energy` is written in the unknowns
+(u, q) and their rates, and the inertia forces are its Lagrange derivative,
+
+.. math:: δq \cdot \Big(\frac{d}{dt}\frac{∂T}{∂\dot q} - \frac{∂T}{∂q}\Big)
+   = \frac{∂p}{∂\dot q}[\ddot q] + \frac{∂p}{∂q}[\dot q] - \frac{∂T}{∂q}[δq],
+   \qquad p = \frac{∂T}{∂\dot q}[δq],
+
+built with ``ufl.derivative`` on placeholder rate fields that the integrator
+(:mod:`beamfx.solvers.integrators`) then replaces by its expressions of the unknown
+:math:`q_{n+1}`. Gyroscopic and centrifugal terms come out of the derivatives, consistent with
+the quaternion parametrisation, and the Jacobian is exact.
+
+Energy bookkeeping, every step: kinetic T, strain Π, work of loads and of prescribed support
+motion (trapezoidal rule on force · increment, reactions from the residual), Rayleigh
+dissipation; what is left is the integrator's numerical dissipation.
+"""
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+import ufl
+
+from ..physics.energy import strain_rate_dissipation
+from ..physics.inertia import kinetic_energy
+from ..physics.kinematics import strains
+from ..solvers import NewtonSolver
+from ..solvers.snes import SolveFailed
+from ..solvers.integrators import AlphaStep, generalized_alpha, hht, newmark
+
+SCHEMES = ("generalized_alpha", "hht", "newmark")
+
+
+@dataclass(frozen=True)
+class TransientSettings:
+    """What ``[analysis] type = "transient"`` says (see docs/scenes.md)."""
+
+    t_end: float
+    dt: float
+    scheme: str = "generalized_alpha"
+    rho_inf: float = 0.9  # generalized-α
+    hht_alpha: float = 0.05  # HHT
+    dt_min: float | None = None  # smallest step after cut-backs (default dt/1000)
+    easy_iterations: int = 4  # a step in at most this many iterations may grow the next one
+    damping_mass: float = 0.0  # Rayleigh a0 (1/s): force a0 M q̇
+    damping_stiffness: float = 0.0  # Rayleigh a1 (s): viscous stress a1 C ε̇
+    rotary_inertia: str = "full"
+    output_every: int = 1  # ParaView frames every n steps (probes and energies every step)
+    checkpoint_every: int = 50  # steps between checkpoints (0: never)
+
+    def parameters(self):
+        if self.scheme == "hht":
+            return hht(self.hht_alpha)
+        if self.scheme == "newmark":
+            return newmark()
+        return generalized_alpha(self.rho_inf)
+
+
+class StepRecord(NamedTuple):
+    step: int
+    time: float
+    dt: float
+    iterations: int
+    residuals: tuple
+    cutbacks: int
+    energy: dict  # kinetic, strain, work_loads, work_supports, dissipated_damping, numerical
+
+
+class TransientResult(NamedTuple):
+    steps: tuple  # StepRecord of accepted steps (all of them)
+    newton_iterations: int
+    seconds: dict
+    stopped_by: str  # "t_end" or the reason of a failure
+
+
+class TransientFailed(SolveFailed):
+    """A time step that Newton could not take even at the smallest step size."""
+
+
+class Dynamics:
+    """Residual and Jacobian of one time step, and the energy forms, for a :class:`BeamModel`.
+
+    The state at t_n lives in Functions (``q_n``, ``v_n``, ``a_n``, ``qdd_n``); the step
+    size ``h`` is a constant, so changing it recompiles nothing.
+    """
+
+    def __init__(self, model, settings):
+        from dolfinx import fem
+        from petsc4py import PETSc
+
+        self.model, self.settings = model, settings
+        W, w, kin = model.W, model.w, model.kin
+        self.q_n, self.v_n, self.a_n, self.qdd_n = (fem.Function(W) for _ in range(4))
+        mesh = model.mesh.mesh
+
+        def constant(x):
+            return fem.Constant(mesh, PETSc.ScalarType(x))
+
+        params = settings.parameters()
+        self.h = constant(settings.dt)
+        self.scheme = AlphaStep(params, self.h, params._replace(**{
+            k: constant(getattr(params, k)) for k in ("alpha_m", "alpha_f", "beta", "gamma")
+        }))  # fmt: skip
+        a0, a1 = constant(settings.damping_mass), constant(settings.damping_stiffness)
+        V, A = fem.Function(W), fem.Function(W)  # placeholders of q̇ and q̈
+        test = ufl.TestFunction(W)
+
+        def T_of(q, v):
+            (_, rot), (u_dot, rot_dot) = ufl.split(q), ufl.split(v)
+            T = kinetic_energy(
+                kin, rot, u_dot, rot_dot, model.inertia, model.Lam0, settings.rotary_inertia
+            )
+            return T * model.dx
+
+        T = T_of(w, V)
+        p = ufl.derivative(T, V, test)
+        inertia = ufl.derivative(p, V, A) + ufl.derivative(p, w, V) - ufl.derivative(T, w, test)
+        power = 0  # dissipated power of the Rayleigh damping, as a form of V
+        if settings.damping_mass:
+            inertia += a0 * p
+            power += a0 * 2 * T
+        if settings.damping_stiffness:
+            u, rot = ufl.split(w)
+            Gamma, K = strains(kin, u, rot, model.t0, model.Lam0)
+            rate = [ufl.derivative(x, w, V) for x in (Gamma, K)]
+            D = strain_rate_dissipation(*rate, model.C_N, model.C_M, a1, model.dx_shear, model.dx)
+            inertia += ufl.derivative(D, V, test)
+            power += 2 * D
+        v_expr, qdd_expr = self.scheme.rates(w, self.q_n, self.v_n, self.a_n, self.qdd_n)
+        self.F = model.F + ufl.replace(inertia, {V: v_expr, A: qdd_expr})
+        self.J = ufl.derivative(self.F, w, ufl.TrialFunction(W))
+        # energies at the state (w, v_n): evaluated after v_n holds the new velocity
+        self.kinetic = ufl.replace(T, {V: self.v_n})
+        # of a free body only (nothing holds it): supported, they are not conserved anyway
+        free = not (model.spec.supports or model.spec.springs)
+        self.momenta = self._momenta(settings.rotary_inertia) if free else []
+        self.power = ufl.replace(power, {V: self.v_n}) if power != 0 else None
+        self.loads = model.load_factor * model.work if model.work is not None else None
+
+    def _momenta(self, rotary):
+        """Linear and angular momentum (about the origin), global axes: ∫ ρA u̇ ds and
+        ∫ x × ρA u̇ + Λ J Λᵀ ω ds; conserved by a free body under no load."""
+        from ..physics.inertia import angular_velocity, spatial_inertia
+        from ..physics.kinematics import displacement
+
+        m, kin = self.model, self.model.kin
+        (u, rot), (u_dot, rot_dot) = ufl.split(m.w), ufl.split(self.v_n)
+        rho_A = m.inertia[0]
+        velocity = displacement(kin, u_dot)
+        x = ufl.SpatialCoordinate(m.mesh.mesh) + displacement(kin, u)
+        p = rho_A * velocity
+        L = ufl.cross(x, p)
+        if rotary != "none":
+            J = spatial_inertia(kin, rot, m.Lam0, [m.inertia[i] for i in (1, 2, 3)], rotary)
+            L += J * angular_velocity(kin, rot, rot_dot)
+        return [p[i] * m.dx for i in range(3)] + [L[i] * m.dx for i in range(3)]
+
+    def start(self):
+        """State at t = 0 from the model's current unknowns, at rest (q̇ = q̈ = a = 0)."""
+        self.q_n.x.array[:] = self.model.w.x.array
+        for f in (self.v_n, self.a_n, self.qdd_n):
+            f.x.array[:] = 0.0
+
+    def predict(self, h):
+        """Newton's starting point: the step with unchanged acceleration, and the prescribed
+        values of the supports at t_{n+1} (a mismatch there would start Newton from a state
+        with a sudden strain at the support)."""
+        from dolfinx import fem
+
+        w = self.model.w
+        w.x.array[:] = self.scheme.predict(
+            self.q_n.x.array, self.v_n.x.array, self.a_n.x.array, h
+        )
+        fem.set_bc(w.x.array, self.model.bcs)
+
+    def accept(self, h):
+        """Move the converged q_{n+1} (in the model's unknowns) into the state at t_n."""
+        arrays = [f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n)]
+        v, a, qdd = self.scheme.advance(self.model.w.x.array, *arrays, h)
+        self.v_n.x.array[:], self.a_n.x.array[:], self.qdd_n.x.array[:] = v, a, qdd
+        self.q_n.x.array[:] = self.model.w.x.array
+
+    def state(self):
+        return {k: getattr(self, k).x.array.copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
+
+    def set_state(self, arrays):
+        for k, a in arrays.items():
+            getattr(self, k).x.array[:] = a
+        self.model.w.x.array[:] = self.q_n.x.array
+
+
+class EnergyBalance:
+    """Kinetic and strain energy, work of loads and supports, and dissipation, step by step.
+
+    Works are trapezoidal sums of (force at t_n + force at t_{n+1})/2 · Δq over the dofs;
+    the supports' forces are the reactions (the residual without boundary conditions, on
+    the constrained dofs).
+    """
+
+    def __init__(self, dyn, bc_dofs):
+        import dolfinx.fem.petsc as fp
+
+        from ..solvers.forms import compile_form
+
+        self.dyn, m = dyn, dyn.model
+        self.T = compile_form(dyn.kinetic)
+        self.Pi = compile_form(m.Pi)
+        self.P = compile_form(dyn.power) if dyn.power is not None else None
+        self.f_loads = compile_form(dyn.loads) if dyn.loads is not None else None
+        self.momenta = [compile_form(f) for f in dyn.momenta]
+        self.residual = compile_form(dyn.F)
+        self.vec = fp.create_vector(self.residual)
+        self.mask = np.zeros(len(m.w.x.array), bool)  # constrained, owned dofs
+        self.mask[bc_dofs] = True
+        self.n_owned = m.W.dofmap.index_map.size_local * m.W.dofmap.index_map_bs
+        self.mask[self.n_owned :] = False
+        self.values = dict.fromkeys(
+            ("work_loads", "work_supports", "dissipated_damping"), 0.0
+        )
+        self.previous = None
+
+    def _scalar(self, form):
+        from dolfinx import fem
+
+        return self.dyn.model.comm.allreduce(fem.assemble_scalar(form))
+
+    def _vector(self, form):
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        with self.vec.localForm() as b:
+            b.set(0.0)
+        fp.assemble_vector(self.vec, form)
+        self.vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        return self.vec.array_r[: self.n_owned].copy()
+
+    def reactions(self):
+        """Support reactions at the converged q_{n+1}: call before the state moves on (the
+        residual's rates are expressions of the state at t_n)."""
+        self._reaction = self._vector(self.residual) * self.mask
+
+    def record(self, q_old, h):
+        """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0)."""
+        owned = slice(0, self.n_owned)
+        q = self.dyn.model.w.x.array[owned].copy()
+        now = {
+            "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
+            "reaction": self._reaction,
+            "power": self._scalar(self.P) if self.P is not None else 0.0,
+        }
+        if self.previous is not None:
+            dq = q - q_old[owned]
+            comm = self.dyn.model.comm
+            prev = self.previous
+
+            def trapezoid(key):
+                return comm.allreduce(float(np.dot(0.5 * (prev[key] + now[key]), dq)))
+
+            if self.f_loads is not None:
+                self.values["work_loads"] += trapezoid("loads")
+            self.values["work_supports"] += trapezoid("reaction")
+            self.values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
+        self.previous = now
+        out = {"kinetic": self._scalar(self.T), "strain": self._scalar(self.Pi), **self.values}
+        if self.momenta:
+            momenta = [self._scalar(f) for f in self.momenta]
+            out["linear_momentum"], out["angular_momentum"] = momenta[:3], momenta[3:]
+        if not hasattr(self, "initial"):
+            self.initial = out["kinetic"] + out["strain"]
+        out["numerical"] = (
+            out["work_loads"]
+            + out["work_supports"]
+            - out["dissipated_damping"]
+            - (out["kinetic"] + out["strain"] - self.initial)
+        )
+        return out
+
+    def get(self):
+        return {"values": dict(self.values), "initial": self.initial, "previous": self.previous}
+
+    def set(self, saved):
+        self.values, self.initial, self.previous = (
+            dict(saved["values"]),
+            saved["initial"],
+            saved["previous"],
+        )
+
+
+def _bc_dofs(bcs):
+    from .buckling import constrained_dofs
+
+    return constrained_dofs(bcs)
+
+
+def _checkpoint_path(folder, comm):
+    return Path(folder) / f"checkpoint_{comm.size}ranks_{comm.rank}.npz"
+
+
+def save_checkpoint(folder, dyn, balance, t, h, step):
+    """The state needed to go on from t (written atomically, one file per rank)."""
+    import pickle
+
+    path = _checkpoint_path(folder, dyn.model.comm)
+    tmp = path.with_suffix(".tmp.npz")
+    extra = pickle.dumps({"t": t, "h": h, "step": step, "balance": balance.get()})
+    np.savez(tmp, extra=np.frombuffer(extra, np.uint8), **dyn.state())
+    tmp.replace(path)
+
+
+def load_checkpoint(folder, comm):
+    """The saved state, or None if there is no checkpoint for this number of ranks."""
+    import pickle
+
+    path = _checkpoint_path(folder, comm)
+    if not path.exists():
+        return None
+    data = np.load(path)
+    out = {k: data[k] for k in ("q_n", "v_n", "a_n", "qdd_n")}
+    out.update(pickle.loads(data["extra"].tobytes()))
+    return out
+
+
+def solve_transient(
+    model,
+    settings,
+    on_step=None,
+    log=None,
+    progress=None,
+    options=None,
+    checkpoint_dir=None,
+    restart=False,
+    prefix="beamfx_transient_",
+):
+    """March from t = 0 (at rest in the model's current state) to ``settings.t_end``.
+
+    Each step is one Newton solve (SNES) for q_{n+1}. A step that fails is retried with half
+    the step size down to ``dt_min``; after ``easy_iterations`` or fewer the step grows by 1.5
+    up to ``dt``. ``on_step(record)`` is called after every accepted step (and at t = 0 with
+    step 0), so output is written as the run goes; checkpoints every ``checkpoint_every``
+    steps let ``restart=True`` go on from the last one.
+
+    Raises:
+        TransientFailed: naming the time, the step size and the residual history, after the
+            last good state was checkpointed (when ``checkpoint_dir`` is set).
+    """
+    t_start = time.perf_counter()
+    from ..solvers.forms import compile_seconds
+
+    c0 = compile_seconds[0]
+    s = settings
+    dyn = Dynamics(model, s)
+    solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
+    solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
+    balance = EnergyBalance(dyn, _bc_dofs(model.bcs))
+    compile_time = compile_seconds[0] - c0
+    dt_min = s.dt_min or s.dt / 1000
+    log = log or (lambda msg: None)
+
+    saved = load_checkpoint(checkpoint_dir, model.comm) if restart and checkpoint_dir else None
+    model.set_load_factor(1.0)
+    if saved is not None:
+        dyn.set_state({k: saved[k] for k in ("q_n", "v_n", "a_n", "qdd_n")})
+        t, h, step = saved["t"], saved["h"], saved["step"]
+        balance.set(saved["balance"])
+        model.set_time(t)
+        log(f"restart from the checkpoint at t = {t:.6g} (step {step})")
+    else:
+        t, h, step = 0.0, s.dt, 0
+        model.set_time(0.0)
+        dyn.start()
+        balance.reactions()
+        record = StepRecord(0, 0.0, 0.0, 0, (), 0, balance.record(None, 0.0))
+        if on_step:
+            on_step(record)
+    records, easy_run, iterations = [], 0, 0
+    q_old = model.w.x.array.copy()
+    while t < s.t_end * (1 - 1e-12):
+        h = min(h, s.t_end - t)
+        cutbacks, tried = 0, []
+        while True:
+            dyn.h.value = h
+            model.set_time(t + h)
+            dyn.predict(h)
+            report = solver.solve()
+            if report.converged:
+                break
+            tried.append((h, report.reason, report.residuals))
+            model.w.x.array[:] = dyn.q_n.x.array
+            h, cutbacks = h / 2, cutbacks + 1
+            if h < dt_min:
+                if checkpoint_dir:
+                    save_checkpoint(checkpoint_dir, dyn, balance, t, h * 2, step)
+                lines = [
+                    f"  dt = {dt:.3g}: {reason}, residuals {', '.join(f'{r:.3e}' for r in res)}"
+                    for dt, reason, res in tried
+                ]
+                raise TransientFailed(
+                    f"time step from t = {t:.6g} failed at every step size down to "
+                    f"dt_min = {dt_min:.3g}:\n" + "\n".join(lines)
+                )
+            log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
+        q_old[:] = dyn.q_n.x.array
+        balance.reactions()
+        dyn.accept(h)
+        t += h
+        step += 1
+        iterations += report.iterations
+        record = StepRecord(
+            step, t, h, report.iterations, report.residuals, cutbacks, balance.record(q_old, h)
+        )
+        records.append(record)
+        if on_step:
+            on_step(record)
+        if progress:
+            progress(record)
+        if s.checkpoint_every and checkpoint_dir and step % s.checkpoint_every == 0:
+            save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
+        easy_run = easy_run + 1 if report.iterations <= s.easy_iterations else 0
+        if cutbacks == 0 and easy_run >= 2:
+            h = min(s.dt, 1.5 * h)
+    if checkpoint_dir:
+        save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
+    seconds = {
+        "compile": compile_time,
+        **{k: v for k, v in solver.seconds.items()},
+        "total": time.perf_counter() - t_start,
+    }
+    solver.destroy()
+    return TransientResult(tuple(records), iterations, seconds, "t_end")
