@@ -167,7 +167,9 @@ def test_paraview_reads_transient_modal_and_buckling(tmp_path, analysis, keys):
     folder = Path(comm.bcast(str(tmp_path), root=0))
     scene = SHAKEN.replace('"ANALYSIS"', f'"{analysis}"\n{keys}')
     if analysis == "buckling":  # a column under an end load instead of the shaken base
-        scene = scene.replace('displacement = [0.02, 0, 0]\nhistory = "(1 - cos(pi * t / 0.2)) / 2"', "")
+        scene = scene.replace(
+            'displacement = [0.02, 0, 0]\nhistory = "(1 - cos(pi * t / 0.2)) / 2"', ""
+        )
         scene += '[[loads]]\nat = "arm:end"\nforce = [0, 0, -1]\n'
     if comm.rank == 0:
         (folder / "scene.toml").write_text(scene)
@@ -179,8 +181,8 @@ def test_paraview_reads_transient_modal_and_buckling(tmp_path, analysis, keys):
     assert error is None, error
     assert report["ok"], report["failed"]
     files = report["files"]
-    frames = results["time_steps"] // 2 + 1 if analysis == "transient" else {"modal": 4}.get(
-        analysis, 2
+    frames = (
+        results["time_steps"] // 2 + 1 if analysis == "transient" else {"modal": 4}.get(analysis, 2)
     )
     assert {f["times"] for f in files.values() if "times" in f} == {frames}
     assert files["surface.pvd"]["points"] > files["deformed.pvd"]["points"]

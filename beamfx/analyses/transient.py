@@ -26,11 +26,11 @@ import numpy as np
 import ufl
 
 from ..physics.energy import strain_rate_dissipation
-from ..physics.inertia import kinetic_energy
-from ..physics.kinematics import strains
+from ..physics.inertia import angular_velocity, kinetic_energy, point_kinetic_energy
+from ..physics.kinematics import displacement, strains
 from ..solvers import NewtonSolver
-from ..solvers.snes import SolveFailed
 from ..solvers.integrators import AlphaStep, generalized_alpha, hht, newmark
+from ..solvers.snes import SolveFailed
 
 SCHEMES = ("generalized_alpha", "hht", "newmark")
 
@@ -114,7 +114,10 @@ class Dynamics:
             T = kinetic_energy(
                 kin, rot, u_dot, rot_dot, model.inertia, model.Lam0, settings.rotary_inertia
             )
-            return T * model.dx
+            u_dot3, omega = displacement(kin, u_dot), angular_velocity(kin, rot, rot_dot)
+            return T * model.dx + model.point_mass_terms(
+                lambda pm: point_kinetic_energy(kin, rot, u_dot3, omega, pm.mass, pm.inertia)
+            )
 
         T = T_of(w, V)
         p = ufl.derivative(T, V, test)
@@ -172,9 +175,7 @@ class Dynamics:
         from dolfinx import fem
 
         w = self.model.w
-        w.x.array[:] = self.scheme.predict(
-            self.q_n.x.array, self.v_n.x.array, self.a_n.x.array, h
-        )
+        w.x.array[:] = self.scheme.predict(self.q_n.x.array, self.v_n.x.array, self.a_n.x.array, h)
         fem.set_bc(w.x.array, self.model.bcs)
 
     def accept(self, h):
@@ -218,9 +219,7 @@ class EnergyBalance:
         self.mask[bc_dofs] = True
         self.n_owned = m.W.dofmap.index_map.size_local * m.W.dofmap.index_map_bs
         self.mask[self.n_owned :] = False
-        self.values = dict.fromkeys(
-            ("work_loads", "work_supports", "dissipated_damping"), 0.0
-        )
+        self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
         self.previous = None
 
     def _scalar(self, form):

@@ -102,9 +102,7 @@ def run_case(case, log=print):
     for setting in case.settings:  # (elements, degree) or, for transients, (…, dt)
         n, p = setting[:2]
         row = (
-            case.run_setting(*setting)
-            if hasattr(case, "run_setting")
-            else run_setting(case, n, p)
+            case.run_setting(*setting) if hasattr(case, "run_setting") else run_setting(case, n, p)
         )
         rows.append(row)
         if log:

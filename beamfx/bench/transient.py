@@ -222,7 +222,12 @@ register(
             "run: nonlinear beam shapes 3.26 s, MSC Nastran 40.1 s, intrinsic beam 132 s "
             "(Howcroft et al. 2016, other machines)."
         ),
-        extra={"published_wall_s": {"nonlinear beam shapes": 3.26, "MSC Nastran": 40.1,
-                                    "intrinsic beam": 132}},
+        extra={
+            "published_wall_s": {
+                "nonlinear beam shapes": 3.26,
+                "MSC Nastran": 40.1,
+                "intrinsic beam": 132,
+            }
+        },
     )
 )

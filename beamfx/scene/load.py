@@ -137,7 +137,7 @@ def _history(t, key="history"):
     t.used.add(key)
     try:
         if isinstance(raw, bool):
-            raise ValueError(f"{raw!r} is not a number")
+            raise TypeError(f"{raw!r} is not a number")
         if isinstance(raw, (int, float)):
             value = float(raw)
             f = partial(np.full_like, fill_value=value, dtype=float)
@@ -149,14 +149,12 @@ def _history(t, key="history"):
             f = table_function(sub.get("t", list), sub.get("values", list))
             sub.done()
         else:
-            raise ValueError(f"{raw!r} is not a number, expression or table")
+            raise TypeError(f"{raw!r} is not a number, expression or table")
         values = f(np.linspace(0.0, 1.0, 11))
         if not np.all(np.isfinite(values)):
             raise ValueError("it is not finite on [0, 1]")
     except (ValueError, TypeError, ZeroDivisionError, FloatingPointError) as e:
-        t.fail(
-            key, f"{e} (write a number, an expression of t, or {{ t = [...], values = [...] }})"
-        )
+        t.fail(key, f"{e} (write a number, an expression of t, or {{ t = [...], values = [...] }})")
     return f
 
 
