@@ -36,6 +36,23 @@ def _default_dir():
         return WRITTEN_TO
 
 
+def _time_label(folder, time):
+    """"load factor 1", "t = 0.2 s" or "mode 3", from the analysis in results.json (written
+    at the end of a run; a run still going is labelled by its step value)."""
+    import json
+
+    try:
+        with open(os.path.join(folder, "results.json"), encoding="utf-8") as f:
+            analysis = json.load(f).get("analysis")
+    except (OSError, ValueError):
+        analysis = None
+    if analysis == "transient":
+        return f"t = {time:g} s"
+    if analysis in ("modal", "buckling"):
+        return f"mode {time:g}"
+    return f"load factor {time:g}" if analysis else f"step value {time:g}"
+
+
 def _last_time(reader):
     times = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
     return times[-1]
@@ -90,7 +107,8 @@ def show_results(folder, view=None, time=None):
     bar.RangeLabelFormat = "%-#.3g"
     out["display"] = disp
 
-    label = pvs.Text(Text=f"{os.path.basename(os.path.abspath(folder))}: load factor {time:g}")
+    name = os.path.basename(os.path.abspath(folder))
+    label = pvs.Text(Text=f"{name}: {_time_label(folder, time)}")
     label_show = pvs.Show(label, view)
     label_show.WindowLocation = "Upper Left Corner"
     label_show.FontSize, label_show.Color = 18, (0.1, 0.1, 0.1)
@@ -106,14 +124,16 @@ def show_results(folder, view=None, time=None):
         pass
     view.OrientationAxesVisibility = 1
     view.UseFXAA = 1  # anti-aliasing: thin beams and their edges without jaggies
+    shown.UpdatePipeline(time)  # the colour range of the time shown, not of the first one
     disp.RescaleTransferFunctionToDataRange(False, True)
     fit_camera(view)
     return out
 
 
-def fit_camera(view, direction=VIEW_DIRECTION, up=VIEW_UP, zoom=1.3):
+def fit_camera(view, direction=VIEW_DIRECTION, up=VIEW_UP, zoom=0.95):
     """Look at everything shown from ``direction`` (towards the camera), ``up`` upwards,
-    ``zoom`` times closer than ParaView's reset (which leaves room for any rotation)."""
+    ``zoom`` times closer than ParaView's reset (which fits the bounding sphere; closer cuts
+    off the near end of a beam that stands upright on the screen, magnified by perspective)."""
     pvs.Render(view)  # the first render resets the camera: do it before setting ours
     view.CameraFocalPoint = (0.0, 0.0, 0.0)
     view.CameraPosition = direction
