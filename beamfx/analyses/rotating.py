@@ -13,7 +13,7 @@ The frame turns at Ω = speed · axis about an axis through the hub point; the k
 
 Everything is in the axes of the rotating frame. The scene's other loads are fixed in that
 frame and scaled with the same load factor. Rotary inertia is "full" or "none": the polar part
-alone (the "polar" of :mod:`beamfx.modal`) is no model of a spinning section, whose centrifugal
+alone (the "polar" of :data:`beamfx.physics.inertia.ROTARY`) is no model of a spinning section, whose centrifugal
 moment needs all three inertias (for a tilted section it is ρI_y, not ρI_polar, that acts).
 """
 
@@ -41,7 +41,8 @@ class RotatingFrame:
 
     Attributes: ``F``, ``J`` (residual and tangent with the centrifugal potential, scaled by
     the model's load factor), ``G`` (gyroscopic), ``M`` (mass), ``omega`` and ``hub``
-    (``fem.Constant``).
+    (``fem.Constant``). The scene's point masses take part like the sections (a point mass
+    keeps its rotary inertia whatever ``rotary`` says, as in the mass form).
     """
 
     def __init__(self, model, axis=(0.0, 0.0, 1.0), hub=(0.0, 0.0, 0.0), rotary="full"):
@@ -74,7 +75,7 @@ class RotatingFrame:
         J = spatial_inertia(kin, rot, model.Lam0, rho_I) if rotary == "full" else ufl.zero((3, 3))
         v_u3, v_theta = displacement(kin, v_u), spatial_virtual_rotation(kin, rot, v_rot)
 
-        def point_J(pm):  # a point mass keeps its rotary inertia (as in the mass form)
+        def point_J(pm):
             return point_inertia(kin, rot, pm.inertia)
 
         V_c = centrifugal_potential(rho_A, J, self.omega, r) * model.dx
@@ -125,6 +126,12 @@ class RotatingFrame:
         n = model.mesh.mesh.topology.index_map(1).size_local
         values = self._stretch.eval(np.arange(n, dtype=np.int32))
         return model.comm.allreduce(float(np.min(values, initial=np.inf)), op=MPI.MIN)
+
+    def destroy(self):
+        """Free the PETSc objects of the Newton solvers."""
+        for solver in self._newton.values():
+            solver.destroy()
+        self._newton = {}
 
     def newton(self, prefix, options=None):
         """A Newton solver on (F, J), one per prefix and options, kept for later speeds."""
@@ -214,7 +221,7 @@ def solve_rotating_modes(frame, n_modes=6, options=None, prefix="beamfx_rotating
     t0 = time.perf_counter()
     if frame.speed != 0.0 and abs(float(frame.model.load_factor.value) - 1.0) > 1e-9:
         raise ValueError("solve the steady state first (the model is not at load factor 1)")
-    forms = frame.compiled()
+    frame.compiled()
     t1 = time.perf_counter()
     K, G, M = assemble_operators(frame)
     t2 = time.perf_counter()
@@ -232,7 +239,6 @@ def solve_rotating_modes(frame, n_modes=6, options=None, prefix="beamfx_rotating
         raise RuntimeError(f"only {len(keep)} of {n_modes} modes found ({prefix})")
     lam = pairs.values[keep]
     omega = np.abs(lam.imag)
-    del forms
     return RotatingModes(
         lam,
         omega,

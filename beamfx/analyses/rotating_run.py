@@ -23,7 +23,7 @@ def run_rotating(model, scene, write, log, out):
     (result with ``steps`` and ``seconds``, entries for ``results.json``)."""
     settings = scene.settings
     mass = model.comm.allreduce(float(np.max(model.inertia.x.array, initial=0.0)), op=MPI.MAX)
-    if mass <= 0:
+    if mass <= 0 and not any(pm.mass for pm in getattr(scene.model, "point_masses", ())):
         raise ValueError(
             f"{scene.file}: a rotating analysis needs mass: give [material] rho, or rho_A and "
             "rho_I of the general sections"
@@ -43,6 +43,7 @@ def run_rotating(model, scene, write, log, out):
         on_speed=lambda i, speed: write(i, float(speed)),  # ParaView: the steady state
         log=log,
     )
+    frame.destroy()
     write_campbell(result, out)
     branches = [
         {

@@ -8,21 +8,22 @@ centrifugal load solved nonlinearly, then (λ² M + λ G + K_T) v = 0
 
 The paper's element is Euler-Bernoulli without bending rotary inertia, so are the models here:
 no rotary inertia, and shear made rigid by extrapolation: each setting is solved with the
-shear stiffness per plane GA = f EI/L² at f = 1e5 and 2e5 (the same compiled forms, the section
-field changed in place) and the values extrapolated to 1/f → 0 (the Timoshenko correction is
-linear in 1/GA: -2.3e-5 on both ratios at f = 1e5, and what the extrapolation leaves is of the
-order of its square). The factor balances that remainder against round-off, which grows with
-the penalty: measured at alpha = 0 against the exact 1 + 7.4e-8 (the constant 3.516015 is
-rounded), f = 1e4 leaves -3e-8 (the squared term), f = 1e5 ±3e-8, f = 1e6 up to 5e-7. A truly
-shear-rigid penalty (1e8 EI_z/L², i.e. 1e10 EI_y/L² for flap) costs the flap frequency five
-digits.
+shear stiffness per plane GA = f (EI/L² + N/10) (:func:`stiff_terms`, N the root tension) at
+f = 1e5 and 2e5 (the same compiled forms, the section field changed in place) and the values
+extrapolated to 1/f → 0 (the Timoshenko correction is linear in 1/GA: -2.3e-5 on both ratios
+at f = 1e5, and what the extrapolation leaves is of the order of its square). The factor
+balances that remainder against round-off, which grows with the penalty: measured at alpha = 0
+against the exact 1 + 7.4e-8 (the constant 3.516015 is rounded), f = 1e4 leaves -3e-8 (the
+squared term), f = 1e5 ±3e-8, f = 1e6 up to 5e-7. A truly shear-rigid penalty
+(1e8 EI_z/L², i.e. 1e10 EI_y/L² for flap) costs the flap frequency five digits.
 
 Two cases:
 
 * ``sm210_rotating``: the geometrically exact beam, extensible (EA of the section). Its
   steady state stretches, and the Coriolis forces couple lead-lag with extension.
-* ``sm210_rotating_inextensible``: EA = f EI_z/L² (extrapolated like the shear), which is
-  the paper's model: linearised about the undeformed state with the centrifugal pre-stress.
+* ``sm210_rotating_inextensible``: EA = f (EI_z/L² + N/10) (extrapolated like the shear),
+  the paper's model (it linearises about the undeformed state with the centrifugal
+  pre-stress, without extension).
 """
 
 from dataclasses import replace
@@ -53,13 +54,27 @@ F_STIFF = 1e5  # shear (and, inextensible, axial) stiffness factor, then 2 F_STI
 SETTINGS = tuple((n, p) for p in (2, 3, 4) for n in (1, 2, 4, 8, 16, 32))
 
 
+def stiff_terms(f, alpha=0.0):
+    """(GA_y, GA_z, EA) of the Euler-Bernoulli limit at Ω = α ω_Byth: f (EI/L² + N/10) for
+    each plane, N = ρA Ω² L²/2 the tension at the root. The tension term matters at high
+    speed: a Reissner beam in tension N shears with the stiffness GA − N, and the remainder of
+    the extrapolation is ~(N/GA)²; with f EI/L² alone it was 1.3e-4 on the flap ratio at
+    alpha = 100. N/10 rather than N: GA costs round-off as it grows (1e-6 on the ratios at
+    alpha = 100 with f N, 3e-7 with f N/10, whose remainder (10/f)² is 1e-8)."""
+    N = S210.rho_A * (alpha * OMEGA_BY) ** 2 * L210**2 / 2
+    return (
+        f * (S210.EI_z / L210**2 + N / 10),
+        f * (S210.EI_y / L210**2 + N / 10),
+        f * (S210.EI_z / L210**2 + N / 10),
+    )
+
+
 def blade_model(n, p, f=F_STIFF, extensible=True):
-    """SM 2.10's cantilever along x, clamped at the hub (origin), with GA_y = f EI_z/L²,
-    GA_z = f EI_y/L² (bending in each plane stiff in shear by the same factor) and, unless
-    ``extensible``, EA = f EI_z/L²."""
-    s = replace(S210, GA_y=f * S210.EI_z / L210**2, GA_z=f * S210.EI_y / L210**2)
-    if not extensible:
-        s = replace(s, EA=f * S210.EI_z / L210**2)
+    """SM 2.10's cantilever along x, clamped at the hub (origin), with the shear stiffnesses
+    (and, unless ``extensible``, EA) of :func:`stiff_terms` at α = 0: GA_y = f EI_z/L²,
+    GA_z = f EI_y/L² (each plane stiff in shear by the same factor), EA = f EI_z/L²."""
+    GA_y, GA_z, EA = stiff_terms(f)
+    s = replace(S210, GA_y=GA_y, GA_z=GA_z, EA=S210.EA if extensible else EA)
     return Model(
         beams=(Beam("b", straight(L210), s, n, p),),
         supports=(Support("b:start", CLAMP),),
@@ -85,28 +100,29 @@ def first_flap_and_lead_lag(frame, alpha, n_modes=4):
         n_modes *= 2
 
 
-def _scale_stiffness(model, factor, axial):
-    """Multiply the shear (and, if ``axial``, the axial) stiffness field in place."""
+def set_stiff_terms(model, f, alpha, extensible):
+    """Put :func:`stiff_terms` into the model's stiffness field (in place: no new forms)."""
+    GA_y, GA_z, EA = stiff_terms(f, alpha)
     C = model.stiffness.x.array.reshape(-1, 6)
-    C[:, 1:3] *= factor
-    if axial:
-        C[:, 0] *= factor
+    C[:, 1], C[:, 2] = GA_y, GA_z
+    if not extensible:
+        C[:, 0] = EA
 
 
 def rigid_limit_ratios(n, p, extensible, alphas):
     """Flap and lead-lag ratios ("flap alpha=..." and "lead_lag alpha=..." keys) at each alpha,
     extrapolated to the shear-rigid (and unless ``extensible`` inextensible) limit from
-    f = F_STIFF and 2 F_STIFF; also the model, its rotating frame and the Newton iterations."""
+    f = F_STIFF and 2 F_STIFF (:func:`stiff_terms`); also the model, its rotating frame and
+    the Newton iterations."""
     from ..analyses.model import BeamModel
     from ..analyses.rotating import RotatingFrame
 
     model = BeamModel(blade_model(n, p, F_STIFF, extensible))
     frame = RotatingFrame(model, rotary="none")
     out, its = {}, 0
-    for k, factor in ((1, 1.0), (2, 2.0)):
-        if factor != 1.0:
-            _scale_stiffness(model, factor, not extensible)
+    for k in (1, 2):
         for alpha in alphas:
+            set_stiff_terms(model, k * F_STIFF, alpha, extensible)
             flap, lag, n = first_flap_and_lead_lag(frame, alpha)
             its += n
             for name, value in (("flap", flap / OMEGA_BY), ("lead_lag", lag / OMEGA_BZ)):
@@ -141,7 +157,8 @@ def _paper(table):
 
 NOTE_COMMON = (
     "Euler-Bernoulli limit: shear (and for the inextensible case extension) extrapolated to "
-    "rigid from GA = 1e5 and 2e5 EI/L2, no rotary inertia; consistent mass; steady state by "
+    "rigid from GA = f (EI/L^2 + N/10), f = 1e5 and 2e5, N the root tension; no rotary "
+    "inertia; consistent mass; steady state by "
     "Newton, then the quadratic eigenproblem with the gyroscopic matrix. Paper, BEAM with 32 "
     f"elements (not converged at high alpha): flap {_paper('BEAM_flap')}; lead-lag "
     f"{_paper('BEAM_lead_lag')}. Southwell's first-order relation for the first mode of a "

@@ -37,7 +37,7 @@ def _default_dir():
 
 
 def _time_label(folder, time):
-    """"load factor 1", "t = 0.2 s" or "mode 3", from the analysis in results.json (written
+    """ "load factor 1", "t = 0.2 s" or "mode 3", from the analysis in results.json (written
     at the end of a run; a run still going is labelled by its step value)."""
     import json
 
