@@ -107,3 +107,25 @@ def test_tension_raises_the_bending_frequency():
         solve_static(model, steps=1)
         omega = solve_modes(model, n_modes=2, rotary="polar").omega
         assert np.allclose(omega, np.pi**2 * W_EB * np.sqrt(1 + alpha), rtol=1e-6), omega
+
+
+def test_effective_masses_of_a_cantilever():
+    """Base excitation of a slender clamped beam: the first three bending modes carry 61.3 %,
+    18.8 % and 6.5 % of the mass along their direction (Euler–Bernoulli:
+    m_k = (∫φ_k)² / ∫φ_k², L/h = 100 leaves ~1e-4 of shear and rotary inertia); none along
+    the axis. Each mode's effective mass converges to the beam's; their sum over all modes
+    would be the mass of the free dofs (the clamped node's consistent-mass share is not
+    excited)."""
+    from beamfx.analyses.modal import effective_masses
+    from beamfx.physics.sections import rectangle
+
+    section = rectangle(210e9, 80e9, 7850.0, 0.01, 0.02)
+    spec = cantilever(straight(1.0), section, 16, 3, kinematics=Kinematics(plane="xz"))
+    model = BeamModel(spec)
+    res = solve_modes(model, 4, rotary="polar")
+    m = effective_masses(model, res.modes, "polar")
+    bending = [k for k in range(4) if m[k, 2] > 1e-6 * m[:, 2].sum()]
+    total = 7850.0 * 0.01 * 0.02 * 1.0
+    fractions = m[bending, 2] / total
+    assert fractions[:3] == pytest.approx([0.6131, 0.1883, 0.0647], abs=5e-4)
+    assert np.all(m[:, 0] < 1e-9 * total)

@@ -48,7 +48,7 @@ def run_eigen(model, scene, write, log):
     from types import SimpleNamespace
 
     from .buckling import solve_buckling
-    from .modal import solve_modes
+    from .modal import effective_masses, solve_modes
     from .static import solve_static
 
     settings = scene.settings
@@ -78,10 +78,12 @@ def run_eigen(model, scene, write, log):
         )
         for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
             log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s)")
+        m_eff = effective_masses(model, res.modes, settings["rotary_inertia"])
         _normalise(model, res.modes)
         shapes = _mode_report(model, scene, res.modes)
         extra = {
             "frequencies_hz": res.hz.tolist(),
+            "effective_mass": m_eff.tolist(),
             "omega_rad_s": res.omega.tolist(),
             "prestressed": bool(steps),
             "mode_shapes": shapes,

@@ -129,3 +129,36 @@ def solve_modes(
         pairs.residuals[:n_modes],
         seconds,
     )
+
+
+def effective_masses(model, modes, rotary="full"):
+    r"""Effective modal masses for base excitation along x, y, z (kg), per mode:
+    :math:`m_{k,d} = (φ_k^T M r_d)^2 / (φ_k^T M φ_k)`, with :math:`r_d` the rigid translation
+    of the free dofs along axis d (u_d = 1, rotations unchanged). Summed over all modes they
+    give the mass that moves with the base, so their fractions tell how many modes a base
+    excitation response needs. Meaningful for supported structures (a free one's rigid-body
+    modes take the whole mass). Collective.
+    """
+    import dolfinx.fem.petsc as fp
+
+    from ..analyses.spec import DOF_NAMES
+
+    M = fp.assemble_matrix(compile_form(mass_ufl(model, rotary)), bcs=model.bcs, diagonal=0.0)
+    M.assemble()
+    r, Mr, Mphi = M.createVecRight(), M.createVecLeft(), M.createVecLeft()
+    owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
+    sub_of = {name: comp for name, sub, comp in model.kin.dofs() if sub == 0}
+    out = np.zeros((len(modes), 3))
+    for d, name in enumerate(DOF_NAMES[:3]):
+        if name not in sub_of:  # out of the planar model's plane
+            continue
+        dofs = model.W.sub(0).sub(sub_of[name]).collapse()[1]
+        r.set(0.0)
+        r.array[[i for i in dofs if i < owned]] = 1.0
+        M.mult(r, Mr)
+        for k, mode in enumerate(modes):
+            M.mult(mode.vector, Mphi)
+            out[k, d] = Mr.dot(mode.vector) ** 2 / Mphi.dot(mode.vector)
+    for obj in (M, r, Mr, Mphi):
+        obj.destroy()
+    return out
