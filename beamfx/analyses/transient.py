@@ -199,13 +199,18 @@ class EnergyBalance:
 
     Works are trapezoidal sums of (force at t_n + force at t_{n+1})/2 · Δq over the dofs;
     the supports' forces are the reactions (the residual without boundary conditions, on
-    the constrained dofs).
+    the constrained dofs), assembled only if a support moves (else they do no work).
+
+    Args:
+        dyn: the :class:`Dynamics`.
+        residual: its residual ``dyn.F``, compiled (the Newton solver's).
     """
 
-    def __init__(self, dyn, bc_dofs):
+    def __init__(self, dyn, residual):
         import dolfinx.fem.petsc as fp
 
         from ..solvers.forms import compile_form
+        from .buckling import constrained_dofs
 
         self.dyn, m = dyn, dyn.model
         self.T = compile_form(dyn.kinetic)
@@ -213,14 +218,15 @@ class EnergyBalance:
         self.P = compile_form(dyn.power) if dyn.power is not None else None
         self.f_loads = compile_form(dyn.loads) if dyn.loads is not None else None
         self.momenta = [compile_form(f) for f in dyn.momenta]
-        self.residual = compile_form(dyn.F)
+        self.residual = residual
+        self.moving = any(s.history is not None for s in m.spec.supports)
         self.vec = fp.create_vector(self.residual)
         self.mask = np.zeros(len(m.w.x.array), bool)  # constrained, owned dofs
-        self.mask[bc_dofs] = True
+        self.mask[constrained_dofs(m.bcs)] = True
         self.n_owned = m.W.dofmap.index_map.size_local * m.W.dofmap.index_map_bs
         self.mask[self.n_owned :] = False
         self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
-        self.previous = None
+        self.previous = self.initial = None
 
     def _scalar(self, form):
         from dolfinx import fem
@@ -240,7 +246,7 @@ class EnergyBalance:
     def reactions(self):
         """Support reactions at the converged q_{n+1}: call before the state moves on (the
         residual's rates are expressions of the state at t_n)."""
-        self._reaction = self._vector(self.residual) * self.mask
+        self._reaction = self._vector(self.residual) * self.mask if self.moving else 0.0
 
     def record(self, q_old, h):
         """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0)."""
@@ -261,14 +267,15 @@ class EnergyBalance:
 
             if self.f_loads is not None:
                 self.values["work_loads"] += trapezoid("loads")
-            self.values["work_supports"] += trapezoid("reaction")
+            if self.moving:
+                self.values["work_supports"] += trapezoid("reaction")
             self.values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
         self.previous = now
         out = {"kinetic": self._scalar(self.T), "strain": self._scalar(self.Pi), **self.values}
         if self.momenta:
             momenta = [self._scalar(f) for f in self.momenta]
             out["linear_momentum"], out["angular_momentum"] = momenta[:3], momenta[3:]
-        if not hasattr(self, "initial"):
+        if self.initial is None:
             self.initial = out["kinetic"] + out["strain"]
         out["numerical"] = (
             out["work_loads"]
@@ -287,12 +294,6 @@ class EnergyBalance:
             saved["initial"],
             saved["previous"],
         )
-
-
-def _bc_dofs(bcs):
-    from .buckling import constrained_dofs
-
-    return constrained_dofs(bcs)
 
 
 def _checkpoint_path(folder, comm):
@@ -331,7 +332,7 @@ def solve_transient(
     progress=None,
     options=None,
     checkpoint_dir=None,
-    restart=False,
+    saved=None,
     prefix="beamfx_transient_",
 ):
     """March from t = 0 (at rest in the model's current state) to ``settings.t_end``.
@@ -340,7 +341,8 @@ def solve_transient(
     the step size down to ``dt_min``; after ``easy_iterations`` or fewer the step grows by 1.5
     up to ``dt``. ``on_step(record)`` is called after every accepted step (and at t = 0 with
     step 0), so output is written as the run goes; checkpoints every ``checkpoint_every``
-    steps let ``restart=True`` go on from the last one.
+    steps let a later call go on from the last one: pass it as ``saved``
+    (:func:`load_checkpoint`).
 
     Raises:
         TransientFailed: naming the time, the step size and the residual history, after the
@@ -354,12 +356,11 @@ def solve_transient(
     dyn = Dynamics(model, s)
     solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
     solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
-    balance = EnergyBalance(dyn, _bc_dofs(model.bcs))
+    balance = EnergyBalance(dyn, solver.F)
     compile_time = compile_seconds[0] - c0
     dt_min = s.dt_min or s.dt / 1000
     log = log or (lambda msg: None)
 
-    saved = load_checkpoint(checkpoint_dir, model.comm) if restart and checkpoint_dir else None
     model.set_load_factor(1.0)
     if saved is not None:
         dyn.set_state({k: saved[k] for k in ("q_n", "v_n", "a_n", "qdd_n")})
@@ -425,7 +426,7 @@ def solve_transient(
         save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
     seconds = {
         "compile": compile_time,
-        **{k: v for k, v in solver.seconds.items()},
+        **solver.seconds,
         "total": time.perf_counter() - t_start,
     }
     solver.destroy()

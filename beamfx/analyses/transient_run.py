@@ -54,12 +54,6 @@ def motion_warnings(model, t_end, samples=4000):
     return out
 
 
-def _tty():
-    import sys
-
-    return sys.stdout.isatty()
-
-
 def _columns(probes):
     cols = ["step", "time", "dt", "iterations", "cutbacks"]
     for name in probes:
@@ -129,7 +123,7 @@ def run_transient(model, scene, out, write, log, restart=False):
         with jsonl.open("a") as f:
             f.write(json.dumps(entry) + "\n")
 
-    bar = Progress(label="transient", every=0.2 if _tty() else 5.0)
+    bar = Progress(label="transient", every=5.0)
 
     def progress(r):
         residual = r.residuals[-1] if r.residuals else 0.0
@@ -148,7 +142,7 @@ def run_transient(model, scene, out, write, log, restart=False):
             progress=progress,
             options=scene.solver_options,
             checkpoint_dir=out,
-            restart=restart,
+            saved=saved,
         )
     finally:
         bar.close()

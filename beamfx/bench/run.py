@@ -13,6 +13,14 @@ def _error(case, values, ref):
     return float(max(diffs))
 
 
+def per_iteration(result):
+    """Seconds per Newton iteration of a (warm) solve: assembly, LU, triangular solves, the
+    rest (Python); ``result`` has ``seconds`` and ``newton_iterations``."""
+    its = max(result.newton_iterations, 1)
+    keys = ("assemble_F", "assemble_J", "factorise", "triangular_solve", "python")
+    return {k: result.seconds[k] / its for k in keys}
+
+
 def run_setting(case, elements, degree):
     """Solve one setting twice (cold: first in this process, warm: the same solver again)."""
     from ..analyses.model import BeamModel
@@ -34,12 +42,7 @@ def run_setting(case, elements, degree):
     t1 = time.perf_counter()
     warm_result = solve_static(model, steps=steps, solver=solver)
     warm = time.perf_counter() - t1
-    # per Newton iteration of the warm solve: assembly, LU, triangular solves, the rest (Python)
-    its = max(warm_result.newton_iterations, 1)
-    split = {
-        k: warm_result.seconds[k] / its
-        for k in ("assemble_F", "assemble_J", "factorise", "triangular_solve", "python")
-    }
+    split = per_iteration(warm_result)
     solver.destroy()
     return {
         "elements": elements,

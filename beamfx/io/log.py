@@ -30,14 +30,16 @@ class Progress:
         self.active = comm.rank == 0
         self.tty = self.active and hasattr(self.stream, "isatty") and self.stream.isatty()
         self._width = 0
-        self.every = every  # seconds between lines (None: every update)
+        # seconds between lines shown (None: every update); a terminal line is cheap to
+        # overwrite, so it refreshes at least 5 times as often as plain lines are written
+        self.every = every and (min(every, 0.2) if self.tty else every)
         self._last = None
 
     def update(self, done, text=""):
         """Report ``done`` units finished, with an optional note (e.g. "λ = 0.5, 4 its").
 
         With ``every`` set, updates closer than that many seconds to the last one shown are
-        skipped (a time stepper may take thousands of steps)."""
+        skipped (a time stepper may take thousands of steps); on a terminal at most 0.2 s."""
         if not self.active:
             return
         now = time.monotonic()

@@ -114,8 +114,8 @@ class _Series:
         """Keep the entries of an existing file up to time ``t_max`` (a restarted run)."""
         if self.comm.rank != 0 or not os.path.exists(self.path):
             return
-        self.entries = [e for e in self._read(ET.parse(self.path).getroot()) if e[0] <= t_max]
-        self.entries = [e[1] for e in self.entries]
+        root = ET.parse(self.path).getroot()
+        self.entries = [entry for t, entry in self._read(root) if t <= t_max]
         _write_atomic(self.path, self._tree())
 
 

@@ -30,6 +30,32 @@ class EigenPairs(NamedTuple):
     seconds: float
 
 
+def solve_and_collect(solver, A, nev, prefix, keep):
+    """Run a configured SLEPc EPS or PEP ``solver`` (operators of the size of ``A``), check
+    that ``nev`` pairs converged, and return (values, [keep(vr, vi) per pair], errors,
+    iterations); the solver is destroyed.
+
+    Raises:
+        RuntimeError: if fewer than ``nev`` pairs converged.
+    """
+    solver.solve()
+    n = solver.getConverged()
+    if n < nev:
+        reason = solver.getConvergedReason()
+        solver.destroy()
+        raise RuntimeError(f"SLEPc ({prefix}): {n} of {nev} eigenpairs converged, reason {reason}")
+    values, vectors, errors = [], [], []
+    vr, vi = A.createVecs()
+    for i in range(n):
+        values.append(solver.getEigenpair(i, vr, vi))
+        vectors.append(keep(vr, vi))
+        errors.append(solver.computeError(i))
+    its = solver.getIterationNumber()
+    for obj in (solver, vr, vi):
+        obj.destroy()
+    return values, vectors, errors, its
+
+
 def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=None):
     """The ``nev`` eigenpairs of A x = λ B x nearest to ``target``.
 
@@ -56,22 +82,7 @@ def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=N
     eps.getST().setShift(target if shift is None else shift)
     with petsc_options(prefix, {**DEFAULT_OPTIONS, **(options or {})}):
         eps.setFromOptions()
-    eps.solve()
-    n = eps.getConverged()
-    if n < nev:
-        reason = eps.getConvergedReason()
-        eps.destroy()
-        raise RuntimeError(f"SLEPc ({prefix}): {n} of {nev} eigenpairs converged, reason {reason}")
-    values, vectors, errors = [], [], []
-    vr, vi = A.createVecs()
-    for i in range(n):
-        values.append(eps.getEigenpair(i, vr, vi))
-        vectors.append(vr.copy())
-        errors.append(eps.computeError(i))
-    its = eps.getIterationNumber()
-    eps.destroy()
-    vr.destroy()
-    vi.destroy()
+    values, vectors, errors, its = solve_and_collect(eps, A, nev, prefix, lambda vr, vi: vr.copy())
     order = np.argsort(np.abs(np.asarray(values) - target), kind="stable")
     return EigenPairs(
         np.asarray(values)[order],

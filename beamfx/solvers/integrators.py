@@ -70,22 +70,21 @@ class AlphaStep:
     def __init__(self, params, h, constants=None):
         self.p, self.h, self.c = params, h, constants or params
 
-    def _a(self, q, q_n, v_n, a_n, h, p):
-        return (q - q_n - h * v_n - h**2 * (0.5 - p.beta) * a_n) / (p.beta * h**2)
-
-    def rates(self, q, q_n, v_n, a_n, qdd_n, h=None):
-        """(q̇_{n+1}, q̈_{n+1}) from q_{n+1} = ``q`` and the previous state; works on UFL
-        expressions (``h`` None: the UFL constants) and on NumPy arrays alike."""
-        p, h = (self.c, self.h) if h is None else (self.p, h)
-        a = self._a(q, q_n, v_n, a_n, h, p)
+    def _step(self, q, q_n, v_n, a_n, qdd_n, h, p):
+        """(a_{n+1}, q̇_{n+1}, q̈_{n+1}) from q_{n+1} = ``q``, parameters ``p``."""
+        a = (q - q_n - h * v_n - h**2 * (0.5 - p.beta) * a_n) / (p.beta * h**2)
         v = v_n + h * (1 - p.gamma) * a_n + h * p.gamma * a
         qdd = ((1 - p.alpha_m) * a + p.alpha_m * a_n - p.alpha_f * qdd_n) / (1 - p.alpha_f)
-        return v, qdd
+        return a, v, qdd
+
+    def rates(self, q, q_n, v_n, a_n, qdd_n):
+        """(q̇_{n+1}, q̈_{n+1}) as UFL expressions of q_{n+1} = ``q`` (the constants ``h`` and
+        parameters, so that a new step size or ρ∞ recompiles nothing)."""
+        return self._step(q, q_n, v_n, a_n, qdd_n, self.h, self.c)[1:]
 
     def advance(self, q, q_n, v_n, a_n, qdd_n, h):
         """New (v, a, q̈) arrays at t_{n+1} for the converged q_{n+1} = ``q`` (step ``h``)."""
-        a = self._a(q, q_n, v_n, a_n, h, self.p)
-        v, qdd = self.rates(q, q_n, v_n, a_n, qdd_n, h)
+        a, v, qdd = self._step(q, q_n, v_n, a_n, qdd_n, h, self.p)
         return v, a, qdd
 
     def predict(self, q_n, v_n, a_n, h):

@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .eigen import solve_and_collect, solve_eigen
 from .options import petsc_options
 
 DEFAULT_OPTIONS = {
@@ -44,7 +45,6 @@ def scale_estimate(K, M, nev, prefix):
     of 32 quartic elements); with any factor within two decades of the wanted |λ| they agree
     with the generalised problem to 1e-12.
     """
-    from .eigen import solve_eigen
 
     pairs = solve_eigen(K, M, nev, 0.0, prefix + "scale_", hermitian=False)
     for x in pairs.vectors:
@@ -85,22 +85,9 @@ def solve_quadratic(K, G, M, nev, target, prefix, options=None, scale=None):
     pep.setTarget(target)
     with petsc_options(prefix, {**DEFAULT_OPTIONS, **options}):
         pep.setFromOptions()
-    pep.solve()
-    n = pep.getConverged()
-    if n < nev:
-        reason = pep.getConvergedReason()
-        pep.destroy()
-        raise RuntimeError(f"SLEPc ({prefix}): {n} of {nev} eigenpairs converged, reason {reason}")
-    values, vectors, errors = [], [], []
-    vr, vi = K.createVecs()
-    for i in range(n):
-        values.append(pep.getEigenpair(i, vr, vi))
-        vectors.append((vr.getArray().copy(), vi.getArray().copy()))
-        errors.append(pep.computeError(i))
-    its = pep.getIterationNumber()
-    pep.destroy()
-    vr.destroy()
-    vi.destroy()
+    values, vectors, errors, its = solve_and_collect(
+        pep, K, nev, prefix, lambda vr, vi: (vr.getArray().copy(), vi.getArray().copy())
+    )
     values = np.asarray(values, dtype=complex)
     order = np.argsort(np.abs(values - target), kind="stable")
     return QuadraticPairs(
