@@ -52,6 +52,7 @@ def tip_after(model, settings):
         {"scheme": "generalized_alpha", "rho_inf": 0.8},
         {"scheme": "hht", "hht_alpha": 0.1},
         {"scheme": "newmark"},
+        {"scheme": "conserving"},
     ],
 )
 def test_second_order_in_time(scheme):
