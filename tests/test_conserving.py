@@ -30,16 +30,23 @@ def free_flight(spec, t_end, dt=0.05):
     return H, p, L, result
 
 
-def flying_spaghetti_3d():
+def flying_spaghetti_3d(point_masses=()):
     """The flying spaghetti thrown out of its plane: quaternion rotations, all three
     components of the angular momentum."""
     section = Section(1e4, 1e4, 1e4, 500.0, 500.0, 500.0, 1.0, (20.0, 10.0, 10.0))
     beam = Beam("b", Line((6, 0, 0), (0, 8, 0)), section, 8, 2)
     load = PointLoad("b:start", (8.0, 0.0, 4.0), (20.0, 40.0, 80.0), "dead", hat)
-    return Model((beam,), (), (load,))
+    return Model((beam,), (), (load,), point_masses=point_masses)
 
 
-@pytest.mark.parametrize("spec", [flying_spaghetti(), flying_spaghetti_3d()], ids=["xy", "3d"])
+TIP_BODY = PointMass("b:end", 2.0, ((1.0, 0.2, 0.0), (0.2, 0.5, 0.0), (0.0, 0.0, 0.5)))
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [flying_spaghetti(), flying_spaghetti_3d(), flying_spaghetti_3d((TIP_BODY,))],
+    ids=["xy", "3d", "3d-tip-body"],
+)
 def test_conserving_scheme_keeps_energy_and_momenta(spec):
     """35 s of free flight (the slowest flexible mode of the free-free beam has a period of
     1.26 s, so about 28 periods): energy and momenta hold to round-off relative to their

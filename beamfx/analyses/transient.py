@@ -151,21 +151,31 @@ class Dynamics:
 
     def _momenta(self, rotary):
         """Linear and angular momentum (about the origin), global axes: ∫ ρA u̇ ds and
-        ∫ x × ρA u̇ + Λ J Λᵀ ω ds; conserved by a free body under no load."""
-        from ..physics.inertia import angular_velocity, spatial_inertia
+        ∫ x × ρA u̇ + Λ J Λᵀ ω ds, plus the point masses' m u̇ and x × m u̇ + R J0 Rᵀ ω;
+        conserved by a free body under no load."""
+        from ..physics.inertia import angular_velocity, point_inertia, spatial_inertia
         from ..physics.kinematics import displacement
 
         m, kin = self.model, self.model.kin
         (u, rot), (u_dot, rot_dot) = ufl.split(m.w), ufl.split(self.v_n)
-        rho_A = m.inertia[0]
         velocity = displacement(kin, u_dot)
         x = ufl.SpatialCoordinate(m.mesh.mesh) + displacement(kin, u)
-        p = rho_A * velocity
+        omega = angular_velocity(kin, rot, rot_dot)
+        p = m.inertia[0] * velocity
         L = ufl.cross(x, p)
         if rotary != "none":
             J = spatial_inertia(kin, rot, m.Lam0, [m.inertia[i] for i in (1, 2, 3)], rotary)
-            L += J * angular_velocity(kin, rot, rot_dot)
-        return [p[i] * m.dx for i in range(3)] + [L[i] * m.dx for i in range(3)]
+            L += J * omega
+
+        def point_p(pm):
+            return float(pm.mass) * velocity
+
+        def point_L(pm):
+            return ufl.cross(x, point_p(pm)) + point_inertia(kin, rot, pm.inertia) * omega
+
+        return [p[i] * m.dx + m.point_mass_terms(lambda pm: point_p(pm)[i]) for i in range(3)] + [
+            L[i] * m.dx + m.point_mass_terms(lambda pm: point_L(pm)[i]) for i in range(3)
+        ]
 
     def start(self):
         """State at t = 0 from the model's current unknowns, at rest (q̇ = q̈ = a = 0)."""
