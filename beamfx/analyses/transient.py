@@ -47,6 +47,7 @@ class TransientSettings:
     hht_alpha: float = 0.05  # HHT
     dt_min: float | None = None  # smallest step after cut-backs (default dt/1000)
     easy_iterations: int = 4  # a step in at most this many iterations may grow the next one
+    tolerance: float | None = None  # local error per step, relative (None: iteration control)
     damping_mass: float = 0.0  # Rayleigh a0 (1/s): force a0 M q̇
     damping_stiffness: float = 0.0  # Rayleigh a1 (s): viscous stress a1 C ε̇
     rotary_inertia: str = "full"
@@ -98,6 +99,8 @@ class Dynamics:
         self.model, self.settings = model, settings
         W, w, kin = model.W, model.w, model.kin
         self.q_n, self.v_n, self.a_n, self.qdd_n = (fem.Function(W) for _ in range(4))
+        self._is_displacement = np.zeros(len(self.q_n.x.array), bool)
+        self._is_displacement[W.sub(0).collapse()[1]] = True
         quaternion = kin.finite and not kin.plane
         self._q_dofs = np.asarray(W.sub(1).collapse()[1]).reshape(-1, 4) if quaternion else []
         mesh = model.mesh.mesh
@@ -173,9 +176,9 @@ class Dynamics:
         def point_L(pm):
             return ufl.cross(x, point_p(pm)) + point_inertia(kin, rot, pm.inertia) * omega
 
-        return [p[i] * m.dx + m.point_mass_terms(lambda pm: point_p(pm)[i]) for i in range(3)] + [
-            L[i] * m.dx + m.point_mass_terms(lambda pm: point_L(pm)[i]) for i in range(3)
-        ]
+        return [
+            p[i] * m.dx + m.point_mass_terms(lambda pm, i=i: point_p(pm)[i]) for i in range(3)
+        ] + [L[i] * m.dx + m.point_mass_terms(lambda pm, i=i: point_L(pm)[i]) for i in range(3)]
 
     def start(self):
         """State at t = 0 from the model's current unknowns, at rest (q̇ = q̈ = a = 0)."""
@@ -216,6 +219,24 @@ class Dynamics:
         for f in (self.a_n, self.qdd_n):
             a = f.x.array[self._q_dofs]
             f.x.array[self._q_dofs] = a - (np.sum(q * a, axis=1, keepdims=True) + vv) / qq * q
+
+    def error_estimate(self, h, tolerance, length):
+        r"""Local error of the step just converged, in units of the tolerance (≤ 1: accept).
+
+        The Zienkiewicz–Xie estimate :math:`e = h^2 |β - 1/6|\,(\ddot q_{n+1} - \ddot q_n)`,
+        the leading term of the Taylor series that the Newmark relations truncate, per dof
+        scaled by ``tolerance``·(|q_{n+1}| + ``length``) for displacements and
+        ``tolerance``·(|q_{n+1}| + 1) for rotations; root mean square over the owned dofs.
+        """
+        q = self.model.w.x.array
+        arrays = [f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n)]
+        _, _, qdd = self.scheme.advance(q, *arrays, h)
+        e = h**2 * abs(self.scheme.p.beta - 1 / 6) * (qdd - self.qdd_n.x.array)
+        scale = tolerance * (np.abs(q) + np.where(self._is_displacement, length, 1.0))
+        n = self.model.W.dofmap.index_map.size_local * self.model.W.dofmap.index_map_bs
+        comm = self.model.comm
+        total = comm.allreduce(float(np.sum((e[:n] / scale[:n]) ** 2)))
+        return np.sqrt(total / comm.allreduce(n))
 
     def state(self):
         return {k: getattr(self, k).x.array.copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
@@ -356,6 +377,16 @@ def load_checkpoint(folder, comm):
     return out
 
 
+def _size(model):
+    """Diagonal of the model's bounding box: the scale of its displacements."""
+    from mpi4py import MPI
+
+    X = model.mesh.mesh.geometry.x
+    high = model.comm.allreduce(X.max(axis=0), op=MPI.MAX)
+    low = model.comm.allreduce(X.min(axis=0), op=MPI.MIN)
+    return float(np.linalg.norm(high - low))
+
+
 def solve_transient(
     model,
     settings,
@@ -371,8 +402,9 @@ def solve_transient(
 
     Each step is one Newton solve (SNES) for q_{n+1}. A step that fails is retried with half
     the step size down to ``dt_min``; after ``easy_iterations`` or fewer the step grows by 1.5
-    up to ``dt``. ``on_step(record)`` is called after every accepted step (and at t = 0 with
-    step 0), so output is written as the run goes; checkpoints every ``checkpoint_every``
+    up to ``dt``; with ``settings.tolerance`` the local error estimate
+    (:meth:`Dynamics.error_estimate`) rejects and sizes the steps instead.
+    ``on_step(record)`` is called after every accepted step (and at t = 0 with step 0), so output is written as the run goes; checkpoints every ``checkpoint_every``
     steps let a later call go on from the last one: pass it as ``saved``
     (:func:`load_checkpoint`).
 
@@ -392,6 +424,7 @@ def solve_transient(
     projection = Projection(dyn, balance) if s.scheme == "conserving" else None
     compile_time = compile_seconds[0] - c0
     dt_min = s.dt_min or s.dt / 1000
+    length = _size(model)
     log = log or (lambda msg: None)
 
     model.set_load_factor(1.0)
@@ -423,6 +456,15 @@ def solve_transient(
             model.set_time(t + h)
             dyn.predict(h)
             report = solver.solve()
+            if report.converged and s.tolerance:
+                error = dyn.error_estimate(h, s.tolerance, length)
+                if error <= 1.0 or h <= dt_min * (1 + 1e-9):
+                    break
+                reason = f"local error {error:.3g} x tolerance"
+                tried.append((h, reason, report.residuals))
+                model.w.x.array[:] = dyn.q_n.x.array
+                h, cutbacks = max(h * max(0.2, 0.9 * error ** (-1 / 3)), dt_min), cutbacks + 1
+                continue
             if report.converged:
                 break
             tried.append((h, report.reason, report.residuals))
@@ -458,9 +500,12 @@ def solve_transient(
             progress(record)
         if s.checkpoint_every and checkpoint_dir and step % s.checkpoint_every == 0:
             save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
-        easy_run = easy_run + 1 if report.iterations <= s.easy_iterations else 0
-        if cutbacks == 0 and easy_run >= 2:
-            h = min(s.dt, 1.5 * h)
+        if s.tolerance:  # the step that the error estimate asks for (safety factor 0.9)
+            h = min(s.dt, h * min(2.0, 0.9 * max(error, 1e-10) ** (-1 / 3)))
+        else:
+            easy_run = easy_run + 1 if report.iterations <= s.easy_iterations else 0
+            if cutbacks == 0 and easy_run >= 2:
+                h = min(s.dt, 1.5 * h)
     if checkpoint_dir:
         save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
     seconds = {
