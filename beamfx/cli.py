@@ -17,12 +17,30 @@ def main(argv=None):
         action="store_true",
         help="transient: go on from the last checkpoint in the output folder",
     )
+    p.add_argument(
+        "--png",
+        action="store_true",
+        help="also render pictures (PNG, pyvista) of the results into the output folder",
+    )
+    p.add_argument(
+        "--animate",
+        action="store_true",
+        help="transient: also an animated GIF of the frames (implies --png)",
+    )
     p = sub.add_parser("check", help="validate a scene file without solving")
     p.add_argument("scene")
     p = sub.add_parser("bench", help="run the benchmark cases and write a report")
     p.add_argument("cases", nargs="*", help="case ids (default: all); see --list")
     p.add_argument("--report", help="folder for bench.json and README.md")
     p.add_argument("--list", action="store_true", help="list the case ids")
+    p = sub.add_parser("solid", help="the 3D solid of a one-beam scene, compared with the beam")
+    p.add_argument("scene")
+    p.add_argument("--out", help="output folder (default: <the scene's [output] dir>/solid)")
+    p.add_argument("--material", help="linear, svk or neo-hookean (default: from the kinematics)")
+    p.add_argument("--section-cells", type=int, default=2, help="cells across the section")
+    p.add_argument("--layers", type=int, help="cells along the centre line (default: aspect 8)")
+    p.add_argument("--cell", default="hexahedron", help="hexahedron (rectangles) or tetrahedron")
+    p.add_argument("--solver", default="auto", choices=("auto", "direct", "iterative"))
     args = parser.parse_args(argv)
 
     from .scene import SceneError
@@ -31,12 +49,19 @@ def main(argv=None):
         if args.command == "run":
             from .runner import run_scene
 
-            run_scene(args.scene, args.out, restart=args.restart)
+            run_scene(
+                args.scene, args.out, restart=args.restart, png=args.png, animate=args.animate
+            )
         elif args.command == "check":
             from .runner import check_scene
 
             scene = check_scene(args.scene)
             print(f"{args.scene}: OK ({len(scene.model.beams)} beam(s), analysis {scene.analysis})")
+        elif args.command == "solid":
+            from .solid.run import SolidMesh, run_solid
+
+            mesh = SolidMesh(args.section_cells, args.layers, args.cell)
+            run_solid(args.scene, args.out, args.material, mesh, args.solver)
         elif args.command == "bench":
             from .bench import all_cases
             from .bench.run import run_bench

@@ -13,8 +13,11 @@ def default_scene_path():
     return Path(str(resources.files("beamfx") / "scenes" / DEFAULT_SCENE))
 
 
-def run_scene(path=None, out_dir=None, log=None, restart=False):
+def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, animate=False):
     """Solve the scene at ``path`` (built-in default if None); return the results dict.
+
+    With ``png`` (or ``animate``: a GIF of a transient's frames too) pictures of the results
+    are rendered into the output folder after the solve (:mod:`beamfx.io.pictures`).
 
     Writes ``results.json`` only after success (a stale one is removed first), and the
     ParaView series (``deformed.pvd`` / ``deformed.xdmf``) after every accepted load step.
@@ -51,6 +54,12 @@ def run_scene(path=None, out_dir=None, log=None, restart=False):
     check_supported(scene.model)
 
     log(f"beamfx: {path} -> {out}/")
+    refinement = None
+    if scene.accuracy:  # choose elements and degree first (analyses/adaptive.py)
+        from .analyses.adaptive import refine_to_tolerance
+
+        refinement = refine_to_tolerance(scene, comm, log)
+        scene = refinement.scene
     extra_points = [
         *scene.probes.values(),
         *filter(None, [scene.settings.get("control_point")]),
@@ -64,11 +73,20 @@ def run_scene(path=None, out_dir=None, log=None, restart=False):
         f"model: {len(scene.model.beams)} beam(s), {model.mesh.mesh.topology.index_map(1).size_global} elements, degree "
         f"{model.degree}, {model.unknowns()} unknowns, {'finite' if model.kin.finite else 'linear'} kinematics"
     )
+    from .analyses.trimming import Trim, trimming_summary
+
+    trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
+    trim_line, trim_entry = trimming_summary(trim, model.kin, model.unknowns())
+    log(f"model: {trim_line}")
     pvd, xdmf = PvdSeries(out / "deformed.pvd"), XdmfSeries(out / "deformed.xdmf")
     names = [b.name for b in scene.model.beams]
     outlines = model_outlines(scene.model.beams)
     surface = SurfaceSeries(out / "surface.pvd", model.degree, names, outlines)
     write_paraview_script(out)
+    if png or animate:
+        from .io.pictures import write_undeformed
+
+        write_undeformed(out, model, names, outlines)  # before the solve: w = 0
     latest = {}  # probe values of the last accepted step, rotations tracked along the path
 
     def write(step, time):
@@ -131,6 +149,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False):
             "plane": model.kin.plane,
             "shear": model.kin.shear,
             "stretch": model.kin.stretch,
+            "trimming": trim_entry,
         },
         "load_steps": [
             {
@@ -145,6 +164,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False):
         ],
         "newton_iterations": int(sum(s.iterations for s in result.steps)),
         **extra,
+        **({"accuracy": refinement.entry(scene.accuracy)} if refinement else {}),
         "wall_time_s": {**result.seconds, "run": time.perf_counter() - t_start},
         "probes": {name: final[at] for name, at in scene.probes.items()},
         "paraview": {
@@ -154,8 +174,19 @@ def run_scene(path=None, out_dir=None, log=None, restart=False):
             "script": "open_in_paraview.py",
         },
     }
+    if png or animate:
+        from .io.pictures import write_pictures
+
+        results["pictures"] = write_pictures(out, results, log, animate)
     write_json_atomic(results_file, results)
     log(f"done in {results['wall_time_s']['run']:.2f} s; results in {results_file}")
+    if refinement:
+        estimate = f"{refinement.estimate:.3g}" if refinement.estimate is not None else "none"
+        log(
+            f"  accuracy: {scene.accuracy['quantity']} estimated error {estimate} "
+            f"({'within' if refinement.reached else 'NOT within'} tolerance "
+            f"{scene.accuracy['tolerance']:g})"
+        )
     for name, v in results["probes"].items():
         log(
             f"  probe {name}: position {[round(x, 6) for x in v['position']]}, "

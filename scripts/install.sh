@@ -15,7 +15,7 @@ APT_PKGS=(
   python3-mpi4py openmpi-bin python3-venv python3-dev build-essential git make
   paraview python3-paraview xvfb xauth  # pvpython; Debian's ParaView renders through X only
 )
-PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib ruff)
+PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib imageio ruff)
 
 log() { printf '[install] %s\n' "$*"; }
 

@@ -62,8 +62,10 @@ def register(case):
 def all_cases():
     """Import every paper module (they register their cases) and return the registry."""
     from . import (  # noqa: F401
+        adaptive_bend45,
         classic,
         howcroft_2016,
+        planar_rollup,
         schwab_meijaard_2009,
         schwab_meijaard_eigen,
         schwab_meijaard_rotating,

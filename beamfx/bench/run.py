@@ -28,13 +28,24 @@ def run_setting(case, elements, degree):
     from ..io.probes import evaluate_points
     from ..solvers import NewtonSolver
     from ..solvers.forms import compile_seconds
+    from .profiling import jit_seconds
 
     model_spec, steps = case.build(elements, degree)
     c0, t0 = compile_seconds[0], time.perf_counter()
     model = BeamModel(model_spec, extra_points=case.probes.values())
     solver = NewtonSolver(model.F, model.J, model.w, model.bcs, "beamfx_bench_")
-    result = solve_static(model, steps=steps, solver=solver)
-    cold = time.perf_counter() - t0
+    path = []  # the measured values at each load step, for the report's plot
+
+    def on_step(step):
+        t = time.perf_counter()
+        at = evaluate_points(model, list(case.probes.values()))
+        v = case.measure({name: at[p] for name, p in case.probes.items()})
+        path.append({"load_factor": float(step.load_factor), **{k: float(x) for k, x in v.items()}})
+        on_step.seconds += time.perf_counter() - t
+
+    on_step.seconds = 0.0
+    result = solve_static(model, steps=steps, solver=solver, on_step=on_step)
+    cold = time.perf_counter() - t0 - on_step.seconds
     values = evaluate_points(model, list(case.probes.values()))
     values = {name: values[at] for name, at in case.probes.items()}
     measured = {k: float(v) for k, v in case.measure(values).items()}
@@ -43,6 +54,7 @@ def run_setting(case, elements, degree):
     warm_result = solve_static(model, steps=steps, solver=solver)
     warm = time.perf_counter() - t1
     split = per_iteration(warm_result)
+    jit = jit_seconds(case.id, model)  # cold (empty cache, once per case) and cached
     solver.destroy()
     return {
         "elements": elements,
@@ -54,7 +66,9 @@ def run_setting(case, elements, degree):
         "wall_s_warm": warm,
         "jit_s": compile_seconds[0] - c0,
         "warm_per_iteration_s": split,
+        **jit,
         "values": measured,
+        "path": path,
     }
 
 
@@ -137,6 +151,10 @@ def run_case(case, log=print):
         "passed": cheapest is not None,
         "extra": case.extra,
     }
+    for key in ("path", "history"):  # kept for the plots, of the finest setting only
+        series = [row.pop(key, None) for row in rows][-1]
+        if series and len(series) > 2:
+            out[key] = series
     if "problem_size" in case.extra:
         out["criterion_1mm"] = criterion_1mm(rows)
     if "spread" in case.extra:
@@ -147,7 +165,10 @@ def run_case(case, log=print):
     return out
 
 
-def markdown(results):
+def markdown(results, figures=None, note=None):
+    """The report; ``figures`` maps case ids (and "summary") to PNG files beside it, ``note``
+    says why there are none."""
+    figures = figures or {}
     lines = [
         "# beamfx validation report",
         "",
@@ -159,6 +180,13 @@ def markdown(results):
         ),
         "",
     ]
+    if note:
+        lines += [f"*{note}*", ""]
+    if "summary" in figures:
+        lines += [
+            f"![Error over tolerance against warm wall time, every case]({figures['summary']})",
+            "",
+        ]
     lines += [
         "| case | passed | cheapest within tolerance | error | unknowns | warm s |",
         "|---|---|---|---|---|---|",
@@ -173,6 +201,9 @@ def markdown(results):
                 else "- | - | - | - |"
             )
         )
+    from .profiling import case_lines, profile_lines
+
+    lines += profile_lines(results)
     for r in results:
         lines += [
             "",
@@ -180,6 +211,11 @@ def markdown(results):
             "",
             f"*{r['paper']}.* {r['note']}",
             "",
+            *(
+                [f"![{r['id']}: convergence and cost]({figures[r['id']]})", ""]
+                if r["id"] in figures
+                else []
+            ),
             "Reference: "
             + ", ".join(f"{k} = {v:.10g}" for k, v in r["reference"].items())
             + (" (finest setting)" if r["reference_is_finest_setting"] else ""),
@@ -199,6 +235,7 @@ def markdown(results):
                 + " | ".join(f"{row['values'][k]:.8g}" for k in r["reference"])
                 + " |"
             )
+        lines += case_lines(r)  # adaptive and planar-vs-full tables
         c = r["cheapest_within_tolerance"]
         if c and "warm_per_iteration_s" in c:
             t = c["warm_per_iteration_s"]
@@ -259,5 +296,12 @@ def run_bench(ids=None, report=None, log=print):
         out = Path(report)
         out.mkdir(parents=True, exist_ok=True)
         (out / "bench.json").write_text(json.dumps(results, indent=1, default=float))
-        (out / "README.md").write_text(markdown(results))
+        figures, note = {}, None
+        try:
+            from .plots import write_plots
+
+            figures = write_plots(results, out)
+        except ImportError as e:
+            note = f"No plots: matplotlib is missing ({e}); pip install matplotlib"
+        (out / "README.md").write_text(markdown(results, figures, note))
     return results

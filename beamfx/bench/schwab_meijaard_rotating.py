@@ -155,6 +155,15 @@ def _paper(table):
     return ", ".join(f"{a:g}: {v:.7g}" for a, v in zip(ALPHAS, rows[-1]))
 
 
+#: for the report's Campbell plot: the ratios' denominators (rad/s) and the paper's BEAM values
+CAMPBELL = {
+    "omega_By": float(OMEGA_BY),
+    "omega_Bz": float(OMEGA_BZ),
+    "alphas": list(ALPHAS),
+    "paper_flap": list(P210["tables"]["BEAM_flap"]["rows"][-1]),
+    "paper_lead_lag": list(P210["tables"]["BEAM_lead_lag"]["rows"][-1]),
+}
+
 NOTE_COMMON = (
     "Euler-Bernoulli limit: shear (and for the inextensible case extension) extrapolated to "
     "rigid from GA = f (EI/L^2 + N/10), f = 1e5 and 2e5, N the root tension; no rotary "
@@ -177,6 +186,7 @@ register(
         None,
         1e-6,
         SETTINGS,
+        extra={"campbell": CAMPBELL},
         note=NOTE_COMMON
         + " Inextensible, which is the paper's model (pre-stress about the undeformed state): "
         "its converged values are what the paper's BEAM columns tend to at every alpha, 100 "
@@ -198,6 +208,7 @@ register(
         None,
         1e-6,
         SETTINGS,
+        extra={"campbell": CAMPBELL},
         note=NOTE_COMMON
         + " Extensible, geometrically exact: the flap ratios agree with the inextensible model "
         "to O(rho Omega^2 L^2/E) (1e-4 at alpha = 1); lead-lag does not: the Coriolis forces "

@@ -50,14 +50,27 @@ def moment_work(kin, rot, v_rot, moment, kind, arm=None):
     if kind == "follower":
         return ufl.dot(moment, body_virtual_rotation(kin, rot, v_rot))
     if kind == "semitangential":
-        return ufl.derivative(ufl.dot(moment, rotation_vector(kin, rot)), rot, v_rot)
+        return _work_of_potential(
+            kin, rot, v_rot, lambda r: ufl.dot(moment, rotation_vector(kin, r))
+        )
     if kind == "quasitangential":
         if arm is None:
             raise ValueError("a quasitangential moment needs the direction of its arm")
         a = ufl.as_vector([float(c) for c in arm])
         force = ufl.cross(moment, a) / ufl.dot(a, a)
-        return ufl.derivative(ufl.dot(force, section_rotation(kin, rot) * a), rot, v_rot)
+        return _work_of_potential(
+            kin, rot, v_rot, lambda r: ufl.dot(force, section_rotation(kin, r) * a)
+        )
     return ufl.dot(moment, spatial_virtual_rotation(kin, rot, v_rot))
+
+
+def _work_of_potential(kin, rot, v_rot, work):
+    """δ(work(rot)) in the direction ``v_rot``; the planar model's single angle is
+    differentiated as a UFL variable (``ufl.derivative`` needs matching vector shapes)."""
+    if kin.plane:
+        angle = ufl.variable(rot[0])
+        return ufl.diff(work(ufl.as_vector([angle])), angle) * v_rot[0]
+    return ufl.derivative(work(rot), rot, v_rot)
 
 
 def spring_energy(u, k):

@@ -24,6 +24,7 @@ from ..analyses.spec import (
     Spring,
     Support,
 )
+from ..analyses.trimming import PLANE_CHOICES
 from ..geometry import curves
 from ..physics import sections
 from ..physics.kinematics import PLANES, Kinematics
@@ -48,6 +49,8 @@ class Scene:
     output_dir: str = "results"
     solver_options: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)  # [analysis] keys of arclength, modal, buckling
+    trimming: object = None  # analyses.trimming.Trim: the model the builder chose, and why
+    accuracy: dict | None = None  # [accuracy]: tolerance on a probe quantity (adaptive.py)
 
 
 def _curve(t, base):
@@ -381,11 +384,12 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         t.done()
 
     mt = top.table("model", {})
+    plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
     kin = Kinematics(
         finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
         shear=mt.get("shear", bool, True),
         stretch=mt.get("stretch", bool, True),
-        plane=mt.get("plane", str, None, choices=tuple(PLANES)),
+        plane=plane if plane in PLANES else None,
     )
     mt.done()
     at = top.table("analysis", {})
@@ -413,6 +417,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     out_dir = ot.get("dir", str, "results")
     ot.done()
     solver = top.get("solver", dict, {})
+    accuracy_table = top.table("accuracy", None)
     top.done()
 
     model = Model(
@@ -426,8 +431,59 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         point_masses=tuple(masses),
     )
     _check_points(model, probes, file)
+    model, trimming = _trim(model, plane, analysis, settings)
+    accuracy = _accuracy(accuracy_table, probes, analysis)
     _check_model(model, file)
-    return Scene(file, model, analysis, steps, probes, out_dir, dict(solver), settings)
+    return Scene(
+        file, model, analysis, steps, probes, out_dir, dict(solver), settings, trimming, accuracy
+    )
+
+
+def _trim(model, plane, analysis, settings):
+    """The model the scene needs: with ``[model] plane = "auto"`` (the default) the planar one
+    where the scene is a plane problem (:func:`~beamfx.analyses.trimming.choose_plane`)."""
+    from dataclasses import replace
+
+    from ..analyses.trimming import Trim, choose_plane
+
+    if plane != "auto":
+        return model, Trim(model.kinematics.plane, False, f"stated: [model] plane = {plane!r}")
+    trim = choose_plane(model, analysis, settings)
+    if trim.plane:
+        model = replace(model, kinematics=replace(model.kinematics, plane=trim.plane))
+    return model, trim
+
+
+def _accuracy(t, probes, analysis):
+    """``[accuracy]``: element count and degree chosen to meet a tolerance on a probe quantity
+    (:mod:`beamfx.analyses.adaptive`)."""
+    from ..analyses.adaptive import DEGREES, QUANTITIES
+
+    if t is None:
+        return None
+    if analysis not in ("static", "linear_static"):
+        t.fail("tolerance", f"works with static and linear_static analyses, not {analysis!r}")
+    quantity = t.get("quantity", str)
+    name, _, what = quantity.partition(".")
+    if name not in probes or what not in QUANTITIES:
+        t.fail(
+            "quantity",
+            f"{quantity!r}: write '<probe>.<quantity>', probe one of {sorted(probes)}, "
+            f"quantity one of {list(QUANTITIES)}",
+        )
+    out = {
+        "quantity": quantity,
+        "tolerance": t.get("tolerance", float, positive=True),
+        "relative": t.get("relative", bool, False),
+        "start_elements": t.get("start_elements", int, 1, positive=True),
+        "start_degree": t.get("start_degree", int, 2, choices=DEGREES),
+        "max_degree": t.get("max_degree", int, max(DEGREES), choices=DEGREES),
+        "max_unknowns": t.get("max_unknowns", int, 20000, positive=True),
+    }
+    if out["max_degree"] < out["start_degree"]:
+        t.fail("max_degree", f"must be at least start_degree ({out['start_degree']})")
+    t.done()
+    return out
 
 
 def _continuation(t):
@@ -512,6 +568,7 @@ def _transient(t):
         rho_inf=t.get("rho_inf", float, 0.9),
         hht_alpha=t.get("hht_alpha", float, 0.05),
         dt_min=t.get("dt_min", float, dt / 1000, positive=True),
+        tolerance=t.get("tolerance", float, None, positive=True),
         damping_mass=damping.get("mass", float, 0.0),
         damping_stiffness=damping.get("stiffness", float, 0.0),
         rotary_inertia=t.get("rotary_inertia", str, "full", choices=("full", "polar", "none")),

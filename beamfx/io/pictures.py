@@ -1,0 +1,311 @@
+"""Pictures of a run (``beamfx run --png``): the beam drawn as its section surface, coloured by
+|u|, over the undeformed one in grey, rendered off-screen with pyvista.
+
+What is drawn is what ParaView shows (``surface.pvd``, ``deformed.pvd``; see
+:mod:`beamfx.io.surface`): the final state of a static, arc-length or rotating run and of a
+transient (``deformed.png``), one picture per mode of a modal or buckling run (``mode_01.png``
+…, the shape as written for ParaView: added to the state, scaled so that its largest
+displacement is a tenth of the model's size), and with ``animate`` every frame of a transient
+(``animation.gif``, at most :data:`MAX_FRAMES`). Beams without a section outline (``general``
+sections) are drawn as their centre line.
+
+The undeformed section surface (``undeformed.vtu``) is written before the solve by
+:func:`write_undeformed`. The pictures are rendered after the solve in a separate Python
+process (:func:`write_pictures`): VTK's wheel can abort inside a process that imported dolfinx
+first (see the DOLFINx notes), and a crash there must not lose the results. If pyvista is
+missing or rendering fails, the run goes on and the log names the pictures skipped and why.
+"""
+
+import json
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+MAX_FRAMES = 120
+SIZE = (1000, 750)
+GIF_SIZE = (800, 600)  # each frame is rendered in software: smaller is faster
+VIEW_DIRECTION = (1.0, -1.0, 0.8)  # from the scene towards the camera (global axes)
+GREY = (0.62, 0.62, 0.62)
+SCALAR_BAR = {
+    "color": "black",
+    "fmt": "%.3g",
+    "n_labels": 5,
+    "vertical": True,
+    "position_x": 0.86,
+    "position_y": 0.2,
+    "height": 0.6,
+    "width": 0.06,
+    "title_font_size": 16,
+    "label_font_size": 14,
+}
+CHILD = "import pyvista; from beamfx.io.pictures import main; main()"  # pyvista before dolfinx
+
+
+def write_undeformed(folder, model, beam_names, outlines):
+    """``undeformed.vtu``: the section surface of the reference state. Collective; call it
+    before the solve (``model.w`` still zero)."""
+    from .fields import nodal_fields
+    from .paraview import write_unstructured_vtu
+    from .surface import surface_mesh
+
+    fields = nodal_fields(model)
+    if model.comm.rank != 0:
+        return
+    path = os.path.join(folder, "undeformed.vtu")
+    if os.path.exists(path):  # of an earlier run, perhaps of another scene
+        os.remove(path)
+    if not any(v is not None for v in outlines.values()):
+        return
+    mesh = surface_mesh(fields, model.degree, beam_names, outlines)
+    if len(mesh[0]):
+        write_unstructured_vtu(path, *mesh)
+
+
+def picture_plan(results, animate=False):
+    """The pictures of a run from its results dict: a list of ``{"file", "frames", "label"}``,
+    frames being indices into the ParaView series (-1 the last), labels with ``{time}``."""
+    analysis = results.get("analysis")
+    if analysis in ("modal", "buckling"):
+        if analysis == "modal":
+            values = [f"{f:.4g} Hz" for f in results.get("frequencies_hz", [])]
+        else:
+            values = [f"load factor {x:.4g}" for x in results.get("load_factors", [])]
+        return [
+            {
+                "file": f"mode_{i:02d}.png",
+                "frames": [i - 1],
+                "label": f"mode {i}: {v}",
+                "bar": "mode shape",
+            }
+            for i, v in enumerate(values, start=1)
+        ]
+    label = {"transient": "t = {time:g} s", "rotating": "speed {time:g}"}.get(
+        analysis, "load factor {time:g}"
+    )
+    plan = [{"file": "deformed.png", "frames": [-1], "label": label}]
+    if animate and analysis == "transient":
+        plan.append({"file": "animation.gif", "frames": "all", "label": label})
+    return plan
+
+
+def _skip(plan, reason, log):
+    names = ", ".join(p["file"] for p in plan)
+    log(f"pictures skipped ({names}): {reason}")
+    return {"written": [], "skipped": {p["file"]: reason for p in plan}}
+
+
+def write_pictures(folder, results, log=print, animate=False, size=SIZE, timeout=900):
+    """Render the pictures of :func:`picture_plan` into ``folder`` (rank 0 only; the others
+    return None). Never raises for a missing or failing renderer: the log says what was skipped.
+
+    Returns:
+        ``{"written": [file names], "skipped": {file name: reason}}``.
+    """
+    from importlib.util import find_spec
+
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.rank != 0:
+        return None
+    plan = picture_plan(results, animate)
+    if not plan:
+        return {"written": [], "skipped": {}}
+    if find_spec("pyvista") is None:
+        return _skip(plan, "pyvista is not installed (pip install pyvista)", log)
+    env = dict(os.environ)
+    env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    job = json.dumps({"folder": os.fspath(folder), "plan": plan, "size": list(size)})
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", CHILD, job],
+            capture_output=True,
+            text=True,
+            env=env,
+            check=False,
+            timeout=timeout,
+        )
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return _skip(plan, f"the renderer did not run: {e}", log)
+    try:
+        report = json.loads(done.stdout.strip().splitlines()[-1])
+    except (IndexError, ValueError):
+        tail = " ".join((done.stderr or "").strip().splitlines()[-2:])
+        return _skip(plan, f"the renderer failed (exit status {done.returncode}): {tail}", log)
+    for name in report["written"]:
+        log(f"picture: {os.path.join(os.fspath(folder), name)}")
+    if report["skipped"]:
+        for name, reason in report["skipped"].items():
+            log(f"picture skipped ({name}): {reason}")
+    return report
+
+
+# --- the renderer (child process: pyvista imported first, no dolfinx) ------------------------
+
+
+def read_pvd(path):
+    """[(time, absolute file name)] of a ParaView collection file."""
+    root = ET.parse(path).getroot()
+    folder = os.path.dirname(os.path.abspath(path))
+    return [
+        (float(d.get("timestep", 0.0)), os.path.join(folder, d.get("file")))
+        for d in root.iter("DataSet")
+    ]
+
+
+def _frames(folder):
+    """Per ParaView step: (time, surface .vtu or None, centre line .vtu)."""
+    lines = read_pvd(os.path.join(folder, "deformed.pvd"))
+    surface_pvd = os.path.join(folder, "surface.pvd")
+    surfaces = dict(read_pvd(surface_pvd)) if os.path.exists(surface_pvd) else {}
+    return [(t, surfaces.get(t), line) for t, line in lines]
+
+
+def _line_beams(line, surface):
+    """The centre line cells of beams that the surface leaves out (no section outline)."""
+    drawn = set() if surface is None else set(np.unique(surface.point_data["beam"]).tolist())
+    beam = np.asarray(line.point_data["beam"]).astype(int)
+    first = line.cell_connectivity.reshape(-1, 2)[:, 0]
+    keep = ~np.isin(beam[first], list(drawn))
+    return line.extract_cells(np.flatnonzero(keep)) if keep.any() else None
+
+
+def _load(pv, frame):
+    """(deformed surface or None, deformed centre line or None, reference centre line)."""
+    _, surface_file, line_file = frame
+    surface = pv.read(surface_file) if surface_file else None
+    line = _line_beams(pv.read(line_file), surface)
+    reference = None
+    if line is not None:
+        reference = line.copy()
+        reference.points = np.asarray(line.point_data["X"])
+        line.point_data["|u|"] = np.linalg.norm(line.point_data["u"], axis=1)
+    if surface is not None:
+        surface = surface.extract_surface().compute_normals(feature_angle=40.0, split_vertices=True)
+        surface.point_data["|u|"] = np.linalg.norm(surface.point_data["u"], axis=1)
+    return surface, line, reference
+
+
+def _camera(plotter, bounds):
+    """Look along :data:`VIEW_DIRECTION`, z up; a flat model is seen face on."""
+    b = np.asarray(bounds).reshape(3, 2)
+    extent = b[:, 1] - b[:, 0]
+    flat = np.flatnonzero(extent < 1e-6 * max(extent.max(), 1e-300))
+    direction, up = VIEW_DIRECTION, (0.0, 0.0, 1.0)
+    if len(flat) == 1:
+        direction = np.eye(3)[flat[0]] * (-1 if flat[0] == 1 else 1)
+        up = (0.0, 1.0, 0.0) if flat[0] == 2 else (0.0, 0.0, 1.0)
+    plotter.camera_position = [tuple(b.mean(1) + np.asarray(direction)), tuple(b.mean(1)), up]
+    plotter.reset_camera(bounds=list(bounds), render=False)
+    plotter.camera.zoom(0.95)
+
+
+def _union(bounds):
+    b = np.asarray(bounds).reshape(len(bounds), 3, 2)
+    return np.c_[b[:, :, 0].min(0), b[:, :, 1].max(0)].ravel().tolist()
+
+
+class _Scene:
+    """One plotter: the undeformed beam in grey, the current one coloured by |u|; camera and
+    colour range fixed (frames of an animation share them). Nothing renders until a
+    screenshot or GIF frame (software rendering: each render costs)."""
+
+    def __init__(self, pv, folder, size, clim, bounds, title):
+        self.clim, self.title = clim, title
+        self.plotter = p = pv.Plotter(off_screen=True, window_size=list(size))
+        p.set_background("white")
+        p.enable_anti_aliasing("msaa")  # FXAA is not supported with EGL
+        undeformed = os.path.join(folder, "undeformed.vtu")
+        if os.path.exists(undeformed):
+            grey = pv.read(undeformed).extract_surface()
+            p.add_mesh(grey, color=GREY, opacity=0.45, smooth_shading=True, render=False)
+        p.add_axes(color="black")
+        _camera(p, bounds)
+        self.name = os.path.basename(os.path.abspath(folder))
+
+    def show(self, surface, line, reference, label):
+        p, bar = self.plotter, dict(SCALAR_BAR, title=self.title)
+        common = {"scalars": "|u|", "cmap": "viridis", "clim": self.clim, "render": False}
+        common["scalar_bar_args"] = bar
+        if reference is not None:
+            p.add_mesh(
+                reference,
+                color=GREY,
+                line_width=4,
+                render_lines_as_tubes=True,
+                name="reference_line",
+                render=False,
+            )
+        if surface is not None:
+            p.add_mesh(surface, smooth_shading=True, specular=0.3, name="surface", **common)
+        if line is not None:
+            p.add_mesh(line, render_lines_as_tubes=True, line_width=6, name="line", **common)
+        p.add_text(
+            f"{self.name}: {label}",
+            position="upper_left",
+            font_size=12,
+            color="black",
+            name="label",
+            render=False,
+        )
+
+
+def _clim(meshes):
+    top = max((float(np.max(m.point_data["|u|"], initial=0.0)) for m in meshes if m), default=0)
+    return [0.0, top or 1.0]
+
+
+def render(pv, folder, item, frames, size):
+    """Render one plan item (see :func:`picture_plan`) from the ``frames`` of ``folder``."""
+    chosen = range(len(frames)) if item["frames"] == "all" else item["frames"]
+    chosen = [range(len(frames))[i] for i in chosen]
+    if len(chosen) > MAX_FRAMES:  # keep the first and the last
+        chosen = [
+            chosen[i] for i in np.linspace(0, len(chosen) - 1, MAX_FRAMES).round().astype(int)
+        ]
+    loaded = [(frames[i][0], *_load(pv, frames[i])) for i in chosen]
+    meshes = [m for _, s, ln, r in loaded for m in (s, ln, r) if m is not None]
+    undeformed = os.path.join(folder, "undeformed.vtu")
+    if os.path.exists(undeformed):
+        meshes.append(pv.read(undeformed))
+    clim = _clim([m for _, s, ln, _ in loaded for m in (s, ln)])
+    bounds = _union([m.bounds for m in meshes])
+    path = os.path.join(folder, item["file"])
+    if path.endswith(".gif"):
+        size = [min(a, b) for a, b in zip(size, GIF_SIZE)]
+    scene = _Scene(pv, folder, size, clim, bounds, item.get("bar", "displacement"))
+    if item["file"].endswith(".gif"):
+        scene.plotter.open_gif(path, fps=min(20, max(5, len(loaded) // 6)))
+    for t, surface, line, reference in loaded:
+        scene.show(surface, line, reference, item["label"].format(time=t))
+        if path.endswith(".gif"):
+            scene.plotter.write_frame()
+    if not path.endswith(".gif"):
+        scene.plotter.screenshot(path)
+    scene.plotter.close()
+    return item["file"]
+
+
+def main(argv=None):
+    """The renderer's entry: one JSON argument ``{"folder", "plan", "size"}``; prints one JSON
+    line ``{"written": [...], "skipped": {file: reason}}``."""
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    job = json.loads((argv or sys.argv[1:])[0])
+    folder, report = job["folder"], {"written": [], "skipped": {}}
+    try:
+        frames = _frames(folder)
+        if not frames:
+            raise ValueError("no ParaView steps were written")
+    except (OSError, ValueError, ET.ParseError) as e:
+        report["skipped"] = {item["file"]: f"cannot read the results: {e}" for item in job["plan"]}
+        frames = None
+    for item in job["plan"] if frames else ():
+        try:
+            report["written"].append(render(pv, folder, item, frames, job["size"]))
+        except Exception as e:  # noqa: BLE001 - one picture failing leaves the others
+            report["skipped"][item["file"]] = f"{type(e).__name__}: {e}"
+    print(json.dumps(report))

@@ -1,0 +1,128 @@
+"""Forms are compiled once per model: load steps, time steps (also after a cut-back, which
+changes dt), output at every step and a sweep over speeds reuse them.
+
+Every form and expression reaches FFCx through ``dolfinx.jit.ffcx_jit`` (``fem.form``,
+``fem.Expression``); a C compilation (cache miss) goes through FFCx's ``_compile_objects``.
+Both are counted; neither may grow after the first step (or speed).
+"""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from beamfx.analyses.model import BeamModel
+from beamfx.analyses.spec import Beam, Model, Support
+from beamfx.bench._builders import CLAMP, cantilever, straight
+from beamfx.io.probes import evaluate_points
+from beamfx.physics import sections
+from beamfx.physics.kinematics import Kinematics
+
+
+@pytest.fixture
+def jit(monkeypatch):
+    """Counts of forms and expressions handed to FFCx, and of C compilations."""
+    import dolfinx.jit
+    import ffcx.codegeneration.jit as ffcx_jit
+    import ufl
+
+    count = SimpleNamespace(forms=0, expressions=0, c_compiles=0)
+    jit_call, compile_objects = dolfinx.jit.ffcx_jit, ffcx_jit._compile_objects
+
+    def counting(comm, obj, *args, **kwargs):
+        if isinstance(obj, ufl.Form):
+            count.forms += 1
+        elif isinstance(obj, tuple):
+            count.expressions += 1
+        return jit_call(comm, obj, *args, **kwargs)
+
+    def compiling(*args, **kwargs):
+        count.c_compiles += 1
+        return compile_objects(*args, **kwargs)
+
+    monkeypatch.setattr(dolfinx.jit, "ffcx_jit", counting)
+    monkeypatch.setattr(ffcx_jit, "_compile_objects", compiling)
+    count.now = lambda: (count.forms, count.expressions, count.c_compiles)
+    return count
+
+
+def fail_once(solve, at_call):
+    """``solve`` that reports non-convergence at its ``at_call``-th call (forces a cut-back)."""
+    calls = [0]
+
+    def wrapped():
+        calls[0] += 1
+        report = solve()
+        return report._replace(converged=calls[0] != at_call, reason="forced")
+
+    return wrapped
+
+
+def test_load_steps_and_cutbacks_compile_nothing(jit):
+    from beamfx.analyses.static import solve_static
+    from beamfx.solvers import NewtonSolver
+
+    section = sections.Section(1e6, 1e6, 1e6, 1e3, 1e3, 2e3)
+    spec = cantilever(straight(1.0), section, 4, 2, moment=(0, -np.pi * 1e3, 0))
+    model = BeamModel(spec, extra_points=["b:end"])
+    solver = NewtonSolver(model.F, model.J, model.w, model.bcs, "test_count_")
+    solver.solve = fail_once(solver.solve, 2)
+    seen = []
+
+    def on_step(step):
+        evaluate_points(model, ["b:end"])  # output at every step, as beamfx run does
+        seen.append(jit.now())
+
+    result = solve_static(model, steps=4, solver=solver, on_step=on_step)
+    assert any(s.cutbacks for s in result.steps)
+    model.reset()
+    solve_static(model, steps=3, solver=solver, on_step=on_step)  # a second run: same forms
+    assert len(seen) >= 7 and len(set(seen)) == 1, seen
+    solver.destroy()
+
+
+def test_time_steps_and_step_size_changes_compile_nothing(jit, monkeypatch):
+    from beamfx.analyses import transient
+    from beamfx.analyses.transient import TransientSettings, solve_transient
+    from beamfx.bench.transient import spin_up_model
+
+    class Failing(transient.NewtonSolver):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            self.solve = fail_once(self.solve, 3)
+
+    monkeypatch.setattr(transient, "NewtonSolver", Failing)
+    model = BeamModel(spin_up_model(4, 2), extra_points=["b:end"])
+    seen, dts = [], []
+
+    def on_step(r):
+        evaluate_points(model, ["b:end"])
+        seen.append(jit.now())
+        dts.append(r.dt)
+
+    settings = TransientSettings(t_end=0.4, dt=0.05, checkpoint_every=0)
+    result = solve_transient(model, settings, on_step=on_step)
+    assert any(s.cutbacks for s in result.steps) and len(set(dts[1:])) > 1  # dt changed
+    assert len(set(seen)) == 1, seen
+
+
+def test_speed_sweep_compiles_nothing_after_the_first_speed(jit):
+    from beamfx.analyses.campbell import campbell
+    from beamfx.analyses.rotating import RotatingFrame
+
+    section = sections.rectangle(2.1e11, 2.1e11 / 2.6, 7850.0, 0.02, 0.05)
+    spec = Model(
+        beams=(Beam("b", straight(1.0), section, 3, 2),),
+        supports=(Support("b:start", CLAMP),),
+        kinematics=Kinematics(),
+    )
+    model = BeamModel(spec)
+    frame = RotatingFrame(model, rotary="full")
+    seen = []
+    campbell(
+        frame, [0.0, 20.0, 40.0, 60.0], n_modes=2, on_speed=lambda i, s: seen.append(jit.now())
+    )
+    frame.destroy()
+    assert len(seen) == 4
+    # the modes of the first speed are solved after on_speed: compare from the second speed on
+    assert len(set(seen[1:])) == 1, seen
