@@ -90,10 +90,6 @@ def _loads(model, n):
     for ld in (*model.point_loads, *model.distributed_loads):
         if ld.force[n] or any(ld.moment[i] for i in off):
             return f"a load (force {list(ld.force)}, moment {list(ld.moment)}) leaves the plane"
-        if ld.kind in ("semitangential", "quasitangential") and any(ld.moment):
-            # the planar model's moment_work differentiates through a 1-component split of
-            # the unknowns, which UFL refuses ("Coefficient and argument shapes do not match")
-            return f"a {ld.kind} moment (not available in the planar model)"
     if model.gravity[n]:
         return f"gravity {list(model.gravity)} leaves the plane"
     return None

@@ -65,6 +65,7 @@ def all_cases():
         adaptive_bend45,
         classic,
         howcroft_2016,
+        pai_beam,
         planar_rollup,
         schwab_meijaard_2009,
         schwab_meijaard_eigen,
