@@ -1,0 +1,152 @@
+"""The 3D solid of a beam: a coarse linear cantilever against beam theory, the face fit, and
+the bad-input errors."""
+
+import textwrap
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gmsh")
+
+from beamfx.analyses.spec import Beam
+from beamfx.bench import schwab_meijaard_2009 as sm
+from beamfx.bench._builders import straight
+from beamfx.geometry import Arc
+from beamfx.physics import sections
+from beamfx.scene import SceneError
+from beamfx.solid.geometry import SolidMesh, SweepError, check_sweep
+
+SCENE = """
+[material]
+E = 2.1e11
+nu = 0.3
+
+[[beams]]
+name = "b"
+curve = {curve}
+section = {section}
+elements = 2
+degree = 3
+
+[[supports]]
+at = "b:start"
+fix = "all"
+
+[[loads]]
+at = "b:end"
+force = [0, 0, 1e4]
+
+[analysis]
+type = "linear_static"
+"""
+
+
+def _scene(tmp_path, curve, section):
+    path = tmp_path / "scene.toml"
+    path.write_text(textwrap.dedent(SCENE.format(curve=curve, section=section)))
+    return path
+
+
+def test_coarse_cantilever_matches_beam_theory():
+    """Tip force and end moments on a 2 x 4 x 25 Q2 hexahedral cantilever (SM 2.1).
+
+    Bending by a moment is exact for Q2 up to the clamp's restraint of the Poisson
+    contraction (a few 1e-4); the force adds the shear term F L/(k G A) of Timoshenko theory;
+    torsion converges slower (warping restrained at the clamp, two cells across the
+    thickness): 1 % at this mesh, against the Saint-Venant constant.
+    """
+    from beamfx.solid.solve import Solid, SolidSpec
+
+    beam = Beam("b", straight(1.0), sm.S21, 1)
+    loads = {"end": ((0, 0, sm.F), (sm.MX, sm.MY, 0))}
+    solid = Solid(SolidSpec(beam, sm.E, sm.NU, loads=loads, mesh=SolidMesh(2)))
+    report = solid.solve_static()
+    assert report["load_steps"] == 1
+    tip = solid.face_values("end")
+    S = sections.rectangle(sm.E, sm.G, sm.RHO, 0.02, 0.01, nu=sm.NU)
+    u_z = sm.THEORY_21["u_z"] + sm.F / S.GA_z
+    assert tip["displacement"][2] == pytest.approx(u_z, rel=5e-4)
+    assert tip["rotation_vector"][1] == pytest.approx(sm.THEORY_21["phi_y"], rel=5e-4)
+    assert tip["rotation_vector"][0] == pytest.approx(sm.MX / S.GJ, rel=2e-2)
+    assert abs(tip["displacement"][1]) < 1e-6 * abs(u_z)
+
+
+def test_face_fit_of_a_rigid_motion():
+    """The face fit returns a superposed rigid motion exactly: ū = a, θ = b (small)."""
+    from beamfx.solid.solve import Solid, SolidSpec
+
+    beam = Beam("b", straight(1.0), sm.S21, 1)
+    solid = Solid(SolidSpec(beam, sm.E, sm.NU, mesh=SolidMesh(2, 4)))
+    a, b = np.array([1e-3, -2e-3, 3e-3]), np.array([2e-3, 1e-3, -1e-3])
+    c = solid.faces["end"]["c"]
+    solid.u.interpolate(lambda x: a[:, None] + np.cross(b, (x.T - c)).T)
+    v = solid.face_values("end")
+    assert np.allclose(v["displacement"], a, atol=1e-12)
+    assert np.allclose(v["rotation_vector"], b, atol=1e-12)
+
+
+def test_tight_arc_cannot_be_swept():
+    """Radius 0.1 towards section z, half-height h/2 = 0.15: no; towards y (w/2 = 0.05): yes."""
+    section = sections.rectangle(1.0, 0.5, 1.0, 0.3, 0.1)
+    beam = Beam("b", Arc((0, 0, 0), (1, 0, 0), (0, 0, 0.1), 90.0), section, 1)
+    with pytest.raises(SweepError, match="intersect itself"):
+        check_sweep(beam, SolidMesh())
+    beam = Beam("b", Arc((0, 0, 0), (1, 0, 0), (0, 0.1, 0), 90.0), section, 1)
+    check_sweep(beam, SolidMesh())
+
+
+def test_tight_arc_error_names_file_and_key(tmp_path):
+    from beamfx.scene import load_scene
+    from beamfx.solid.run import build, spec_from_scene
+
+    path = _scene(
+        tmp_path,
+        '{ shape = "arc", start = [0, 0, 0], start_tangent = [1, 0, 0], centre = [0, 0, 0.05], angle_deg = 90 }',
+        '{ type = "rectangle", h = 0.2, w = 0.1 }',
+    )
+    spec = spec_from_scene(load_scene(path))
+    with pytest.raises(SceneError, match=r"scene.toml: beams\[0\].curve: arc radius"):
+        build(spec, str(path))
+
+
+def test_too_coarse_section_names_the_option(tmp_path):
+    from beamfx.scene import load_scene
+    from beamfx.solid.run import build, spec_from_scene
+
+    path = _scene(
+        tmp_path,
+        '{ shape = "line", start = [0, 0, 0], end = [1, 0, 0] }',
+        '{ type = "circle", d = 0.02 }',
+    )
+    spec = spec_from_scene(load_scene(path), mesh=SolidMesh(1, None, "tetrahedron"))
+    with pytest.raises(SceneError, match="--section-cells: section_cells = 1 does not resolve"):
+        build(spec, str(path))
+    spec = spec_from_scene(load_scene(path), mesh=SolidMesh(2, 1, "tetrahedron"))
+    with pytest.raises(SceneError, match="--layers: .*too coarse along the centre line"):
+        build(spec, str(path))
+    spec = spec_from_scene(load_scene(path), mesh=SolidMesh(2, None, "hexahedron"))
+    with pytest.raises(SceneError, match="hexahedra need a rectangular section"):
+        build(spec, str(path))
+
+
+@pytest.mark.slow
+def test_neo_hookean_small_load_matches_linear():
+    """At a small load the neo-Hookean and St Venant–Kirchhoff solids give the linear answer."""
+    from beamfx.solid.solve import Solid, SolidSpec
+
+    beam = Beam("b", straight(1.0), sm.S21, 1)
+    tips = {}
+    for material in ("linear", "svk", "neo-hookean"):
+        spec = SolidSpec(
+            beam,
+            sm.E,
+            sm.NU,
+            loads={"end": ((0, 0, 1.0), (0, 0, 0))},
+            material=material,
+            mesh=SolidMesh(2),
+        )
+        solid = Solid(spec)
+        solid.solve_static(steps=1)
+        tips[material] = solid.face_values("end")["displacement"][2]
+    assert tips["svk"] == pytest.approx(tips["linear"], rel=1e-3)
+    assert tips["neo-hookean"] == pytest.approx(tips["linear"], rel=1e-3)
