@@ -9,7 +9,7 @@ export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export PYTHONUNBUFFERED := 1
 
-.PHONY: install run test test-slow bench lint clean
+.PHONY: install run test test-slow bench bench-peers lint clean
 
 install:
 	bash scripts/install.sh
@@ -27,6 +27,15 @@ test-slow: install
 
 bench: install
 	$(VENV)/bin/beamfx bench --report docs/validation
+
+# beamfx beside Exudyn and PyElastica (own venv .venv-peers, not part of `make test`)
+PEERS := build/peers
+bench-peers: install
+	bash scripts/install_peers.sh
+	$(PY) -m beamfx.bench.peers export $(PEERS)
+	.venv-peers/bin/python peers/exudyn_cases.py $(PEERS)
+	.venv-peers/bin/python peers/elastica_cases.py $(PEERS)
+	$(PY) -m beamfx.bench.peers $(PEERS) docs/validation
 
 lint: install
 	$(VENV)/bin/ruff check .

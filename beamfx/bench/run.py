@@ -179,6 +179,12 @@ def markdown(results, figures=None, note=None):
             "load included), warm = the same solve again."
         ),
         "",
+        (
+            "Elsewhere: beamfx beside Exudyn and PyElastica on the same problems, "
+            "[peers.md](peers.md) (`make bench-peers`); the 3D solid against the beam, "
+            "[../solid.md](../solid.md); the Pai beam sweeps, [../pai_beam.md](../pai_beam.md)."
+        ),
+        "",
     ]
     if note:
         lines += [f"*{note}*", ""]

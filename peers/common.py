@@ -1,0 +1,128 @@
+"""Shared helpers of the peer scripts: problem data, records, timing, rotations.
+
+Runs in `.venv-peers` (numpy only; no beamfx, no DOLFINx). The problem data and the
+references come from `problems.json`, which `python -m beamfx.bench.peers export DIR` writes
+from the beamfx cases (section stiffnesses exactly as beamfx builds them; references read by
+beamfx from its json files beamfx/bench/*.json, or computed there where the file has only a
+formula). The merge step recomputes every error with the beamfx metric anyway.
+"""
+
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def load_problems(out_dir):
+    return json.loads((Path(out_dir) / "problems.json").read_text())
+
+
+def error(values, problem):
+    """beamfx's metric: max |v - ref| / scale (scale None: relative per value); None where
+    the reference is withheld (the merge fills it in from the finest beamfx setting)."""
+    ref, scale = problem.get("reference"), problem.get("error_scale")
+    if ref is None or values is None:
+        return None
+    return float(max(abs(values[k] - ref[k]) / (scale or max(abs(ref[k]), 1e-300)) for k in ref))
+
+
+def warm(run):
+    """Call ``run()`` twice; return (second result, second wall time, first wall time)."""
+    t0 = time.perf_counter()
+    run()
+    cold = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    out = run()
+    return out, time.perf_counter() - t1, cold
+
+
+def record(problem_id, problem, code, element, setting, unknowns, wall_s, values, **extra):
+    err = error(values, problem) if values is not None else None
+    r = {
+        "problem": problem_id,
+        "code": code,
+        "element": element,
+        "setting": setting,
+        "unknowns": unknowns,
+        "wall_s": wall_s,
+        "error": err,
+        "values": values,
+    }
+    r.update(extra)
+    e = "—" if err is None else f"{err:.2e}"
+    w = "—" if wall_s is None else f"{wall_s:.3g} s"
+    print(
+        f"  {code} {problem_id} {element} {setting}: {unknowns} unknowns, {w}, error {e}",
+        flush=True,
+    )
+    return r
+
+
+def write(out_dir, code, records, meta=None):
+    path = Path(out_dir) / f"{code}.json"
+    path.write_text(
+        json.dumps({"code": code, "meta": meta or {}, "records": records}, indent=1, default=float)
+    )
+    print(f"wrote {path} ({len(records)} records)")
+
+
+def axis_angle(R):
+    """Unit axis and angle in [0, π] of a rotation matrix (as beamfx reports a tip rotation)."""
+    R = np.asarray(R, float).reshape(3, 3)
+    c = np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)
+    angle = math.acos(c)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    s = np.linalg.norm(w)
+    if s > 1e-8:
+        return w / s, angle
+    # near 0 or π: the axis is the dominant column of R + I
+    B = R + np.eye(3)
+    k = int(np.argmax(np.linalg.norm(B, axis=0)))
+    return B[:, k] / max(np.linalg.norm(B[:, k]), 1e-300), angle
+
+
+def rotation_values(u, R):
+    """The values of Schwab & Meijaard 2.3 as beamfx measures them."""
+    axis, angle = axis_angle(R)
+    return {
+        "u_x": u[0],
+        "u_y": u[1],
+        "u_z": u[2],
+        "e_x": axis[0],
+        "e_y": axis[1],
+        "e_z": axis[2],
+        "phi": angle,
+    }
+
+
+def hub_angle(t):
+    """ψ(t) of vm258_spin_up.json, as beamfx.bench.transient.hub_angle."""
+    t = np.asarray(t, float)
+    ramp = (6 / 15) * (t**2 / 2 + (15 / (2 * np.pi)) ** 2 * (np.cos(2 * np.pi * t / 15) - 1))
+    return np.where(t < 15, ramp, 6 * t - 45)
+
+
+def spin_up_values(t, x, y, theta, L):
+    """beamfx's spin-up measure from the tip history: positions (x, y) and the planar angle."""
+    t, x, y, theta = (np.asarray(a, float) for a in (t, x, y, theta))
+    psi = hub_angle(t)
+    c, s = np.cos(psi), np.sin(psi)
+    axial = c * x + s * y - L
+    transverse = -s * x + c * y
+    rel = theta - psi
+    late = t > 15.0
+    return {
+        "axial_min": float(axial.min()),
+        "transverse_min": float(transverse.min()),
+        "relative_rotation_min": float(rel.min()),
+        "stretch_mean_15_18": float(axial[late].mean()),
+    }
+
+
+def out_dir():
+    if len(sys.argv) < 2:
+        raise SystemExit(f"usage: {sys.argv[0]} DIR (with DIR/problems.json)")
+    return sys.argv[1]

@@ -1,0 +1,80 @@
+"""The merge of peer records (beamfx.bench.peers) on fake records: no peers installed."""
+
+import json
+
+from beamfx.bench import peers
+
+
+def _rec(code, setting, wall, err, problem="p", element="", **kw):
+    return {
+        "problem": problem,
+        "code": code,
+        "element": element,
+        "setting": setting,
+        "unknowns": 10,
+        "wall_s": wall,
+        "error": err,
+        "values": None,
+    } | kw
+
+
+def test_error_is_the_bench_metric():
+    ref = {"x": 2.0, "y": -4.0}
+    assert abs(peers.error({"x": 2.2, "y": -4.0}, ref, None) - 0.1) < 1e-12  # relative
+    assert abs(peers.error({"x": 2.2, "y": -4.0}, ref, 10.0) - 0.02) < 1e-12  # absolute / scale
+    assert peers.error({"x": 2.0}, ref, None) is None  # a missing value is no score
+
+
+def test_rescore_uses_reference_and_skips_the_reference_row():
+    recs = [
+        _rec("beamfx", "ref", 1.0, 0.0, values={"x": 1.0}, is_reference=True),
+        _rec("Exudyn", "8", 0.1, None, values={"x": 1.001}),
+    ]
+    peers.rescore(recs, {"p": {"x": 1.0}}, {"p": None})
+    assert recs[0]["error"] is None
+    assert abs(recs[1]["error"] - 1e-3) < 1e-12
+
+
+def test_summary_target_and_verdict():
+    recs = [
+        _rec("beamfx", "a", 0.05, 1e-3),
+        _rec("beamfx", "b", 0.2, 1e-7),
+        _rec("Exudyn", "8", 0.1, 1e-3, element="GE"),
+        _rec("Exudyn", "64", 1.0, 1e-5, element="GE"),
+        _rec("PyElastica", "—", None, None, note="cannot: no eigen solver"),
+    ]
+    s = peers.summary(recs, "p")
+    assert s["target"] == 1e-5  # the best peer error, larger than 1e-6
+    assert s["beamfx_time"] == 0.2
+    assert s["lines"]["Exudyn (GE)"]["time_to_target"] == 1.0
+    assert s["lines"]["PyElastica"]["best_error"] is None
+    assert s["beamfx_ahead"]
+    recs.append(_rec("Exudyn", "fast", 0.01, 1e-6, element="GE"))
+    s = peers.summary(recs, "p")
+    assert s["target"] == 1e-6 and not s["beamfx_ahead"]
+
+
+def test_markdown_and_plot(tmp_path):
+    recs = [
+        _rec("beamfx", "4 x P4", 0.05, 1e-7),
+        _rec("Exudyn", "8", 0.1, 1e-3, element="GE"),
+        _rec("PyElastica", "—", None, None, note="cannot: no eigen solver"),
+    ]
+    md = peers.markdown(recs, {"p": {"title": "fake", "beamfx_case": "c"}}, {"p": "a note"})
+    assert "| p | 1.0e-03 |" in md and "cannot: no eigen solver" in md and "a note" in md
+    peers.plot(recs, "p", "fake", tmp_path / "p.png", 1e-3)
+    assert (tmp_path / "p.png").stat().st_size > 1000
+
+
+def test_merge_reads_peer_files_without_running_beamfx(tmp_path):
+    problems = {"p": {"title": "fake", "beamfx_case": "c", "error_scale": None}}
+    (tmp_path / "problems.json").write_text(json.dumps(problems))
+    fx = [_rec("beamfx", "4 x P4", 0.05, None, values={"x": 1.0 + 1e-8})]
+    (tmp_path / "beamfx.json").write_text(
+        json.dumps({"references": {"p": {"x": 1.0}}, "records": fx})
+    )
+    peer = [_rec("Exudyn", "8", 0.1, None, element="GE", values={"x": 1.01})]
+    (tmp_path / "exudyn.json").write_text(json.dumps({"records": peer}))
+    recs = peers.merge(tmp_path, tmp_path / "out", run=False, log=None)
+    assert abs(recs[1]["error"] - 1e-2) < 1e-12
+    assert (tmp_path / "out" / "peers.md").exists() and (tmp_path / "out" / "peers_p.png").exists()
