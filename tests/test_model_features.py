@@ -125,7 +125,7 @@ def test_moments_with_a_potential_in_the_planar_model(plane):
     tips = {
         k: solve(
             cantilever(section, f'moment = [0, -1.0, 0]\nkind = "{k}"{arm}', model=model), ["b:end"]
-        )[1]["b:end"]  # fmt: skip
+        )[1]["b:end"]
         for k, arm in (
             ("dead", ""),
             ("semitangential", ""),

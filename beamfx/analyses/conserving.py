@@ -53,10 +53,9 @@ class Projection:
             self.M_form = compile_form(mass_ufl(m, dyn.settings.rotary_inertia))
             self.M = fp.create_matrix(self.M_form)
             self._dof_layout()
-        self.applies = (
-            not (dyn.settings.damping_mass or dyn.settings.damping_stiffness)
-            and not any(s.history is not None for s in spec.supports)
-        )
+        self.applies = not (
+            dyn.settings.damping_mass or dyn.settings.damping_stiffness
+        ) and not any(s.history is not None for s in spec.supports)
         self.target = None  # (H_n, momenta g_n) of the last accepted state
         self.corrections = []  # α − 1 of each projected step
 
@@ -181,4 +180,3 @@ class Projection:
     def _destroy(fields):
         for vec in (*fields[0], *fields[1]) if fields is not None else ():
             vec.destroy()
-
