@@ -378,12 +378,11 @@ def load_checkpoint(folder, comm):
 
 
 def _size(model):
-    """Diagonal of the model's bounding box: the scale of its displacements."""
-    from mpi4py import MPI
-
+    """Diagonal of the model's bounding box: the scale of its displacements. Collective."""
     X = model.mesh.mesh.geometry.x
-    high = model.comm.allreduce(X.max(axis=0), op=MPI.MAX)
-    low = model.comm.allreduce(X.min(axis=0), op=MPI.MIN)
+    boxes = model.comm.allgather((X.min(axis=0), X.max(axis=0)) if len(X) else None)
+    low = np.min([b[0] for b in boxes if b is not None], axis=0)
+    high = np.max([b[1] for b in boxes if b is not None], axis=0)
     return float(np.linalg.norm(high - low))
 
 
