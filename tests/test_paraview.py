@@ -14,6 +14,7 @@ import json
 import os
 import shutil
 import subprocess
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -114,13 +115,13 @@ at = "arm:end"
 """
 
 
-def _pvcheck(out, tip=None, attempts=3):
+def _pvcheck(out, tip=None, attempts=6):
     """pvcheck.py on ``out`` (rank 0, under a display); its report on every rank.
 
     One pvpython at a time on the machine (a lock file). Now and then pvpython aborts while
     creating its X window on a fresh Xvfb (SIGABRT in vtkXOpenGLRenderWindow::CreateAWindow,
-    about one run in ten here, serial or parallel): that start-up failure, and only it, is
-    retried with a new server.
+    about one run in ten here, serial or parallel, more on a loaded machine): that start-up
+    failure, and only it, is retried with a new server after a pause.
     """
     import fcntl
     import tempfile
@@ -141,6 +142,7 @@ def _pvcheck(out, tip=None, attempts=3):
                     )
                 if not (run.returncode == -6 and "CreateAWindow" in run.stderr):
                     break
+                time.sleep(1.0)
         lines = [ln for ln in run.stdout.splitlines() if ln.startswith("{")]
         if run.returncode != 0 or not lines:
             error = f"pvcheck exit {run.returncode}\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
