@@ -6,31 +6,10 @@ from importlib.util import find_spec
 
 import numpy as np
 import pytest
+from test_paraview import SHAKEN
 
 from beamfx.io import pictures
 from beamfx.runner import run_scene
-
-SHAKEN = """
-[material]
-E = 210e9
-nu = 0.3
-rho = 7850
-[[beams]]
-name = "arm"
-curve = { shape = "line", start = [0, 0, 0], end = [0, 0, 0.5] }
-section = { type = "rectangle", h = 0.002, w = 0.03 }
-elements = 4
-[[supports]]
-at = "arm:start"
-fix = "all"
-displacement = [0.02, 0, 0]
-history = "(1 - cos(pi * t / 0.2)) / 2"
-[analysis]
-type = "ANALYSIS"
-[[probes]]
-name = "tip"
-at = "arm:end"
-"""
 
 # general section (no outline): drawn as its centre line
 STATIC = """

@@ -19,7 +19,8 @@ def rigid_mode_rows(xyz, dofs, centre):
     return rows
 
 
-def _size(model):
+def model_size(model):
+    """The spread of the beams' end points (at least 1): the length scale of a model spec."""
     ends = np.vstack([b.curve.points([0.0, b.curve.length]) for b in model.beams])
     return max(float(np.ptp(ends)), 1.0)
 
@@ -39,7 +40,7 @@ def closest_arc_length(curve, x, samples=400):
 
 def end_contacts(model, rtol=1e-8):
     """(i, j, s): the end of beam i lies on beam j at its arc length s (to rtol of the model)."""
-    tol = rtol * _size(model)
+    tol = rtol * model_size(model)
     out = []
     for i, a in enumerate(model.beams):
         for x in a.curve.points([0.0, a.curve.length]):
@@ -54,7 +55,7 @@ def end_contacts(model, rtol=1e-8):
 def joint_breaks(model, rtol=1e-8):
     """(beam index, arc length) where the end of another beam meets a beam inside its span
     (a T-joint): the mesh needs a vertex there for the joint to exist."""
-    tol = rtol * _size(model)
+    tol = rtol * model_size(model)
     return [
         (j, s)
         for _, j, s in end_contacts(model, rtol)
@@ -181,7 +182,7 @@ def check_planar(model):
     if not plane:
         return
     n = PLANES[plane][2]
-    tol = 1e-9 * _size(model)
+    tol = 1e-9 * model_size(model)
     for b in model.beams:
         x = b.curve.points(np.linspace(0.0, b.curve.length, 101))
         if np.ptp(x[:, n]) > tol:

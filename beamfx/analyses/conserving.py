@@ -52,30 +52,18 @@ class Projection:
 
             self.M_form = compile_form(mass_ufl(m, dyn.settings.rotary_inertia))
             self.M = fp.create_matrix(self.M_form)
-            self._dof_layout()
         self.applies = not (
             dyn.settings.damping_mass or dyn.settings.damping_stiffness
         ) and not any(s.history is not None for s in spec.supports)
         self.target = None  # (H_n, momenta g_n) of the last accepted state
-        self.corrections = []  # α − 1 of each projected step
-
-    def _dof_layout(self):
-        """Displacement dofs per node (in-plane components of a planar model), their
-        reference positions, and rotation dofs per node."""
-        m = self.dyn.model
-        V0, u_dofs = m.W.sub(0).collapse()
-        self.u_dofs = np.asarray(u_dofs).reshape(-1, m.kin.displacement_size)
-        self.X = V0.tabulate_dof_coordinates()
-        self.r_dofs = np.asarray(m.W.sub(1).collapse()[1]).reshape(-1, m.kin.rotation_size)
-        self.axes = PLANES[m.kin.plane][:2] if m.kin.plane else (0, 1, 2)
-        self.rotation_axes = [PLANES[m.kin.plane][2]] if m.kin.plane else [0, 1, 2]
 
     def _rigid_fields(self):
         """Arrays of the rigid-body velocity fields at the current q: translations along the
         (in-plane) axes, then rotations about the axes through the origin."""
-        m = self.dyn.model
-        w, ud, rd, axes = m.w.x.array, self.u_dofs, self.r_dofs, self.axes
-        x = self.X.copy()
+        d, kin = self.dyn, self.dyn.model.kin
+        w, ud, rd = d.model.w.x.array, d.u_dofs, d.r_dofs
+        axes = PLANES[kin.plane][:2] if kin.plane else (0, 1, 2)
+        x = d.u_points.copy()  # current positions of the displacement nodes
         for c, a in enumerate(axes):
             x[:, a] += w[ud[:, c]]
         fields = []
@@ -83,13 +71,13 @@ class Projection:
             f = np.zeros_like(w)
             f[ud[:, c]] = 1.0
             fields.append(f)
-        for k in self.rotation_axes:
+        for k in [PLANES[kin.plane][2]] if kin.plane else [0, 1, 2]:
             e = np.eye(3)[k]
             f = np.zeros_like(w)
             v = np.cross(e, x)
             for c, a in enumerate(axes):
                 f[ud[:, c]] = v[:, a]
-            if m.kin.plane:
+            if kin.plane:
                 f[rd[:, 0]] = 1.0
             else:  # q̇ = ½ (0, e) ∘ q: the spatial angular velocity e
                 q = w[rd]
@@ -98,32 +86,33 @@ class Projection:
             fields.append(f)
         return fields
 
-    def _state(self):
-        """(H, g, M, r, Mr) at the current (q, q̇): energy, momenta and what the projection
-        needs. Collective."""
+    def _operators(self):
+        """At the current q: the rigid fields r_k, M r_k and the Gram matrix G = rᵀ M r
+        (None for a body whose momenta are not conserved). Collective."""
         import dolfinx.fem.petsc as fp
 
-        b = self.balance
-        H = b._scalar(b.T) + b._scalar(b.Pi)
         if not self.rigid:
-            return H, None, None
+            return None
         M = self.M
         M.zeroEntries()
         fp.assemble_matrix(M, self.M_form)
         M.assemble()
-        r = [self._vec(M, f) for f in self._rigid_fields()]
+        r = []
+        for f in self._rigid_fields():
+            rk = M.createVecRight()
+            rk.array[:] = f[: len(rk.array)]
+            r.append(rk)
         Mr = [M.createVecLeft() for _ in r]
         for rk, Mrk in zip(r, Mr):
             M.mult(rk, Mrk)
-        v = self.dyn.v_n.vector
-        g = np.array([Mrk.dot(v) for Mrk in Mr])
-        return H, g, (r, Mr)
+        G = np.array([[Mrk.dot(rl) for rl in r] for Mrk in Mr])
+        return r, Mr, G
 
-    @staticmethod
-    def _vec(M, array):
-        vec = M.createVecRight()
-        vec.array[:] = array[: len(vec.array)]
-        return vec
+    def _momenta(self, operators):
+        """g_k = (M r_k)ᵀ q̇ at the current velocities, or None."""
+        if operators is None:
+            return None
+        return np.array([Mrk.dot(self.dyn.v_n.vector) for Mrk in operators[1]])
 
     def _load_free(self, t):
         """Whether no load acts at time t (every load has a history that is zero there)."""
@@ -140,18 +129,16 @@ class Projection:
         then remember the state's energy and momenta as the next target."""
         from petsc4py import PETSc
 
-        H, g, fields = self._state()
-        free = self._load_free(t_n) and self._load_free(t)
-        if self.applies and free:
+        b = self.balance
+        operators = self._operators()  # q is not changed by the projection: assembled once
+        Pi = b._scalar(b.Pi)
+        if self.applies and self._load_free(t_n) and self._load_free(t):
             H0, g0 = self.target
             v = self.dyn.v_n.vector
-            b = self.balance
-            Pi = b._scalar(b.Pi)
             T_rigid = 0.0
-            if fields is not None:
-                r, Mr = fields
-                G = np.array([[Mrk.dot(rl) for rl in r] for Mrk in Mr])
-                c_now, c_new = np.linalg.solve(G, g), np.linalg.solve(G, g0)
+            if operators is not None:
+                r, _, G = operators
+                c_now, c_new = np.linalg.solve(G, self._momenta(operators)), np.linalg.solve(G, g0)
                 for ck, rk in zip(c_now, r):
                     v.axpy(-ck, rk)  # the flexible part
                 T_rigid = 0.5 * c_new @ G @ c_new
@@ -160,23 +147,19 @@ class Projection:
             room = H0 - Pi - T_rigid
             alpha = np.sqrt(room / T_flex) if room > 0 and T_flex > 1e-14 * abs(H0) else 1.0
             v.scale(alpha)
-            if fields is not None:
+            if operators is not None:
                 for ck, rk in zip(c_new, r):
                     v.axpy(ck, rk)
             v.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-            self.corrections.append(alpha - 1.0)
-            self._destroy(fields)
-            H, g, fields = self._state()
-        self._destroy(fields)
-        self.target = (H, g)
+        self._remember(operators, Pi)
 
     def remember(self):
         """Take the current state's energy and momenta as the target (start, restart)."""
-        H, g, fields = self._state()
-        self._destroy(fields)
-        self.target = (H, g)
+        self._remember(self._operators(), self.balance._scalar(self.balance.Pi))
 
-    @staticmethod
-    def _destroy(fields):
-        for vec in (*fields[0], *fields[1]) if fields is not None else ():
+    def _remember(self, operators, Pi):
+        """The target from the current velocities (energy and momenta measured, not assumed,
+        so round-off does not accumulate unseen)."""
+        self.target = (self.balance._scalar(self.balance.T) + Pi, self._momenta(operators))
+        for vec in (*operators[0], *operators[1]) if operators is not None else ():
             vec.destroy()

@@ -31,6 +31,7 @@ from ..physics.kinematics import displacement, strains
 from ..solvers import NewtonSolver
 from ..solvers.integrators import AlphaStep, generalized_alpha, hht, newmark
 from ..solvers.snes import SolveFailed
+from .checks import model_size
 from .conserving import Projection
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
@@ -99,10 +100,14 @@ class Dynamics:
         self.model, self.settings = model, settings
         W, w, kin = model.W, model.w, model.kin
         self.q_n, self.v_n, self.a_n, self.qdd_n = (fem.Function(W) for _ in range(4))
+        # dofs per node: displacement (with the nodes' reference positions) and rotation
+        V_u, u_dofs = W.sub(0).collapse()
+        self.u_dofs = np.asarray(u_dofs).reshape(-1, kin.displacement_size)
+        self.u_points = V_u.tabulate_dof_coordinates()
+        self.r_dofs = np.asarray(W.sub(1).collapse()[1]).reshape(-1, kin.rotation_size)
         self._is_displacement = np.zeros(len(self.q_n.x.array), bool)
-        self._is_displacement[W.sub(0).collapse()[1]] = True
-        quaternion = kin.finite and not kin.plane
-        self._q_dofs = np.asarray(W.sub(1).collapse()[1]).reshape(-1, 4) if quaternion else []
+        self._is_displacement[self.u_dofs.ravel()] = True
+        self._quaternion = kin.finite and not kin.plane
         mesh = model.mesh.mesh
 
         def constant(x):
@@ -202,7 +207,7 @@ class Dynamics:
         v, a, qdd = self.scheme.advance(self.model.w.x.array, *arrays, h)
         self.v_n.x.array[:], self.a_n.x.array[:], self.qdd_n.x.array[:] = v, a, qdd
         self.q_n.x.array[:] = self.model.w.x.array
-        if len(self._q_dofs):
+        if self._quaternion:
             self._tangent_rates()
 
     def _tangent_rates(self):
@@ -210,15 +215,15 @@ class Dynamics:
         The norm direction has no mass; an integrator without numerical damping (ρ∞ = 1,
         Newmark) would let its meaningless rates grow from step to step until Newton fails
         (measured: the 3D flying spaghetti at t ≈ 27 s), so they are removed."""
-        q = self.q_n.x.array[self._q_dofs]
+        q = self.q_n.x.array[self.r_dofs]
         qq = np.sum(q * q, axis=1, keepdims=True)
-        v = self.v_n.x.array[self._q_dofs]
+        v = self.v_n.x.array[self.r_dofs]
         v -= np.sum(q * v, axis=1, keepdims=True) / qq * q
-        self.v_n.x.array[self._q_dofs] = v
+        self.v_n.x.array[self.r_dofs] = v
         vv = np.sum(v * v, axis=1, keepdims=True)
         for f in (self.a_n, self.qdd_n):
-            a = f.x.array[self._q_dofs]
-            f.x.array[self._q_dofs] = a - (np.sum(q * a, axis=1, keepdims=True) + vv) / qq * q
+            a = f.x.array[self.r_dofs]
+            f.x.array[self.r_dofs] = a - (np.sum(q * a, axis=1, keepdims=True) + vv) / qq * q
 
     def error_estimate(self, h, tolerance, length):
         r"""Local error of the step just converged, in units of the tolerance (≤ 1: accept).
@@ -377,15 +382,6 @@ def load_checkpoint(folder, comm):
     return out
 
 
-def _size(model):
-    """Diagonal of the model's bounding box: the scale of its displacements. Collective."""
-    X = model.mesh.mesh.geometry.x
-    boxes = model.comm.allgather((X.min(axis=0), X.max(axis=0)) if len(X) else None)
-    low = np.min([b[0] for b in boxes if b is not None], axis=0)
-    high = np.max([b[1] for b in boxes if b is not None], axis=0)
-    return float(np.linalg.norm(high - low))
-
-
 def solve_transient(
     model,
     settings,
@@ -423,7 +419,7 @@ def solve_transient(
     projection = Projection(dyn, balance) if s.scheme == "conserving" else None
     compile_time = compile_seconds[0] - c0
     dt_min = s.dt_min or s.dt / 1000
-    length = _size(model)
+    length = model_size(model.spec)  # the scale of the displacements
     log = log or (lambda msg: None)
 
     model.set_load_factor(1.0)

@@ -30,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..physics.kinematics import PLANES
-from .checks import free_rigid_modes, section_axes_at
+from .checks import free_rigid_modes, model_size, section_axes_at
 from .spec import DOF_NAMES
 
 #: analyses whose answer includes out-of-plane motion of a plane structure
@@ -46,11 +46,6 @@ class Trim(NamedTuple):
     plane: str | None
     automatic: bool
     reason: str
-
-
-def _size(model):
-    pts = np.vstack([b.curve.points([0.0, b.curve.length]) for b in model.beams])
-    return max(float(np.ptp(pts)), 1.0)
 
 
 def _in_plane(model, n, tol):
@@ -128,7 +123,7 @@ def plane_fit(model, plane, settings=None):
     """None if ``model`` is a plane problem in ``plane`` ("xy", "yz", "xz"), else the reason
     it is not (a sentence)."""
     n = PLANES[plane][2]
-    tol = 1e-9 * _size(model)
+    tol = 1e-9 * model_size(model)
     for check in (_in_plane, _principal, _loads, _supports, _settings):
         args = (model, n, tol) if check is _in_plane else (model, n)
         if check is _settings:
