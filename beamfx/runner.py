@@ -2,6 +2,7 @@
 
 import os
 import time
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 
@@ -25,7 +26,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
     from mpi4py import MPI
 
     from .analyses.checks import check_supported
-    from .analyses.model import BeamModel
+    from .analyses.condensed import RotationRangeError, build_model
     from .analyses.static import solve_static
     from .io import (
         PvdSeries,
@@ -40,6 +41,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
     from .io import log as default_log
     from .io.surface import SurfaceSeries, model_outlines, write_paraview_script
     from .scene import load_scene
+    from .solvers import SolveFailed
 
     log = log or default_log
     comm = MPI.COMM_WORLD
@@ -64,7 +66,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
         *scene.probes.values(),
         *filter(None, [scene.settings.get("control_point")]),
     ]
-    model = BeamModel(scene.model, comm, extra_points=extra_points)
+    model = build_model(scene.model, comm, extra_points, scene.condense)
     if model.raised_degree:
         log(
             f"note: beams {model.raised_degree} raised to degree {model.degree} (one degree per mesh)"
@@ -78,6 +80,13 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
     trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
     trim_line, trim_entry = trimming_summary(trim, model.kin, model.unknowns())
     log(f"model: {trim_line}")
+    if scene.condense:
+        per_node = 3 + model.full.kin.rotation_size
+        log(
+            "model: statically condensed (a cantilever under point loads): the rotations are "
+            f"the only unknowns, 3 per node instead of {per_node}, {model.unknowns()} instead of "
+            f"{model.unknowns() // 3 * per_node}; shear and stretch kept"
+        )
     pvd, xdmf = PvdSeries(out / "deformed.pvd"), XdmfSeries(out / "deformed.xdmf")
     names = [b.name for b in scene.model.beams]
     outlines = model_outlines(scene.model.beams)
@@ -133,9 +142,21 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
             None, evaluate_points(model, list(scene.probes.values()))
         )
     else:
-        result = solve_static(
-            model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
-        )
+        try:
+            result = solve_static(
+                model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
+            )
+        except (RotationRangeError, SolveFailed) as e:
+            if not scene.condense:
+                raise
+            log(f"model: the statically condensed model failed ({e}); solving the full model")
+            scene = replace(scene, condense=False)
+            model = build_model(scene.model, comm, extra_points, False)
+            latest.clear()
+            write.resume(0.0)  # drop the failed attempt's frames
+            result = solve_static(
+                model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
+            )
     final = latest["probes"]
     results = {
         "scene": str(path),
@@ -150,6 +171,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
             "shear": model.kin.shear,
             "stretch": model.kin.stretch,
             "trimming": trim_entry,
+            "condensed": scene.condense,
         },
         "load_steps": [
             {

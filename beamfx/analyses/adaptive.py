@@ -103,11 +103,11 @@ def _quantity(values, what):
 def solve_once(model_spec, scene, comm, probe_at, what):
     """Build and solve one discretisation; returns (BeamModel, StaticResult, value, seconds)."""
     from ..io.probes import evaluate_points
-    from .model import BeamModel
+    from .condensed import build_model
     from .static import solve_static
 
     t0 = time.perf_counter()
-    model = BeamModel(model_spec, comm, extra_points=[probe_at])
+    model = build_model(model_spec, comm, [probe_at], scene.condense)
     result = solve_static(model, steps=scene.steps, options=scene.solver_options)
     value = _quantity(evaluate_points(model, [probe_at])[probe_at], what)
     return model, result, value, time.perf_counter() - t0
@@ -125,7 +125,8 @@ def refine_to_tolerance(scene, comm, log=None, solve=solve_once):
     trials, estimate, rich = [], None, None
     for n, p in ladder(acc["start_elements"], acc["start_degree"], acc["max_degree"]):
         spec = with_discretisation(scene.model, n, p)
-        per_node = spec.kinematics.displacement_size + spec.kinematics.rotation_size
+        kin = spec.kinematics
+        per_node = 3 if scene.condense else kin.displacement_size + kin.rotation_size
         nodes = sum(b.elements * p + 1 for b in spec.beams)  # upper bound (joints share nodes)
         if trials and nodes * per_node > acc["max_unknowns"]:
             break

@@ -70,14 +70,20 @@ def solve_static(
     from ..solvers.forms import compile_seconds
 
     c0 = compile_seconds[0]
-    solver = solver or NewtonSolver(model.F, model.J, model.w, model.bcs, prefix, options)
+    coupling = getattr(model, "coupling", None)
+    solver = solver or NewtonSolver(
+        model.F, model.J, model.w, model.bcs, prefix, options, coupling=coupling
+    )
     scale = load_scale(model, solver.F)
     solver.set_atol(max(1e-10 * scale, 1e-14))
     compile_time = compile_seconds[0] - c0
 
     def solve_at(lam):
         model.set_load_factor(lam)
-        return solver.solve()
+        report = solver.solve()
+        if report.converged and hasattr(model, "check_state"):
+            model.check_state()  # e.g. the condensed model's range of rotations: raises
+        return report
 
     n = 1 if not model.kin.finite else steps
     before = dict(solver.seconds)

@@ -42,11 +42,14 @@ def _layout(kin):
 
 def section_expression(model):
     """Flat UFL vector of the quantities in the module table, and its layout (name -> slice)."""
-    u, rot = ufl.split(model.w)
-    Gamma, K = strains(model.kin, u, rot, model.t0, model.Lam0)
-    X = ufl.SpatialCoordinate(model.mesh.mesh)
-    N, M = model.C_N * Gamma, model.C_M * K
-    parts = [X, displacement(model.kin, u), rotation_output(model.kin, rot), model.Lam0, N, M]
+    if hasattr(model, "section_parts"):  # a model with its own kinematics (Kirchhoff rod)
+        parts = list(model.section_parts())
+    else:
+        u, rot = ufl.split(model.w)
+        Gamma, K = strains(model.kin, u, rot, model.t0, model.Lam0)
+        X = ufl.SpatialCoordinate(model.mesh.mesh)
+        N, M = model.C_N * Gamma, model.C_M * K
+        parts = [X, displacement(model.kin, u), rotation_output(model.kin, rot), model.Lam0, N, M]
     flat = [p[index] for p in parts for index in np.ndindex(p.ufl_shape)]  # row-major
     layout, size = _layout(model.kin)
     assert len(flat) == size  # internal consistency of the table above

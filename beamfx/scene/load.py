@@ -50,6 +50,7 @@ class Scene:
     solver_options: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)  # [analysis] keys of arclength, modal, buckling
     trimming: object = None  # analyses.trimming.Trim: the model the builder chose, and why
+    condense: bool = False  # the statically condensed model (analyses/condensed.py) is used
     accuracy: dict | None = None  # [accuracy]: tolerance on a probe quantity (adaptive.py)
 
 
@@ -385,6 +386,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
 
     mt = top.table("model", {})
     plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
+    condense = mt.get("condense", str, "auto", choices=("auto", "none"))
     kin = Kinematics(
         finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
         shear=mt.get("shear", bool, True),
@@ -432,10 +434,26 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     )
     _check_points(model, probes, file)
     model, trimming = _trim(model, plane, analysis, settings)
+    if condense == "auto":
+        from ..analyses.condensed import condensed_fit
+
+        condense = condensed_fit(model, analysis) is None
+    else:
+        condense = False
     accuracy = _accuracy(accuracy_table, probes, analysis)
     _check_model(model, file)
     return Scene(
-        file, model, analysis, steps, probes, out_dir, dict(solver), settings, trimming, accuracy
+        file,
+        model,
+        analysis,
+        steps,
+        probes,
+        out_dir,
+        dict(solver),
+        settings,
+        trimming,
+        condense,
+        accuracy,
     )
 
 

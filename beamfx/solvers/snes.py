@@ -75,13 +75,17 @@ class NewtonSolver:
         bcs: Dirichlet conditions; their values are the targets for ``w`` (not increments).
         prefix: PETSc options prefix (mandatory, e.g. "beamfx_static_").
         options: PETSc options without the prefix; merged over :data:`DEFAULT_OPTIONS`.
+        coupling: optional non-local term that forms cannot hold (e.g. a follower force on
+            the Kirchhoff rod, :class:`~beamfx.analyses.kirchhoff.KirchhoffModel`): its
+            ``update()`` runs before each residual assembly (``w`` current) and its
+            ``add_to_tangent(A)`` after each tangent assembly.
     """
 
-    def __init__(self, F, J, w, bcs, prefix, options=None):
+    def __init__(self, F, J, w, bcs, prefix, options=None, coupling=None):
         import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
 
-        self.w, self.bcs = w, bcs
+        self.w, self.bcs, self.coupling = w, bcs, coupling
         self.F, self.J = compile_form(F), compile_form(J)
         self.b = fp.create_vector(self.F)
         self.A = fp.create_matrix(self.J)
@@ -108,12 +112,16 @@ class NewtonSolver:
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         x.copy(self.w.vector)
         self.w.x.scatter_forward()
+        if self.coupling:
+            self.coupling.update()
         assemble_residual(b, self.F, self.J, self.bcs, x)
         self.seconds["assemble_F"] += time.perf_counter() - t
 
     def _jacobian(self, snes, x, A, P):
         t = time.perf_counter()
         assemble_tangent(A, self.J, self.bcs)
+        if self.coupling:
+            self.coupling.add_to_tangent(A)
         self.seconds["assemble_J"] += time.perf_counter() - t
 
     def set_atol(self, atol):

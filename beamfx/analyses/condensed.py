@@ -1,0 +1,376 @@
+r"""The statically condensed beam (:mod:`beamfx.physics.condensed`): a cantilever under point
+loads with the rotation field as its only unknown, three per node instead of seven.
+
+In a statically determinate beam the section force is known from the loads, n(s) = the sum
+of the forces beyond s, so the strains Γ = C_N⁻¹ Λ0ᵀ Rᵀ n can be eliminated from the
+Simo–Reissner energy exactly (:func:`~beamfx.physics.condensed.load_potential`): same
+equilibrium, shear and stretch kept (or dropped, with ``[model] shear``/``stretch`` false: the
+Kirchhoff rod), a fraction of the unknowns. :func:`condensed_fit` says where it applies: a
+static analysis of one beam clamped at its start, loaded by point loads (dead or follower
+forces; dead, follower or semitangential moments) and nothing else.
+
+The loads' work is local in the rotations except for a follower force F = R(g_a) f at s_a:
+n depends on the rotation there. The residual takes F as a constant set from the current g_a
+before each assembly; the tangent adds the missing rank-3 term −λ G (∂F/∂g_a) with
+G_i = ∂/∂g ∫₀^{s_a} e_i·x' ds (:class:`FollowerCoupling`), so Newton converges quadratically.
+
+Output: the object has what the probes and field writers read (``mesh``, ``degree``, ``comm``,
+``kin``, ``w``, :meth:`section_parts`). The displacement is integrated from x' = R(t0 + Λ0 Γ)
+cell by cell (:meth:`sync`, exact to quadrature); the section force is the statically
+determined one, in section axes Λ0ᵀRᵀn.
+"""
+
+from dataclasses import replace
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from ..physics import condensed as rod
+from ..physics.kinematics import Kinematics
+from ..physics.rotations import np_exp_rotation
+from .spec import DOF_NAMES, resolve_point
+
+#: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
+MAX_ANGLE = np.radians(330.0)
+
+
+class RotationRangeError(ValueError):
+    """A rotation beyond :data:`MAX_ANGLE` in the condensed model."""
+
+
+#: moment kinds with a local virtual work in g
+MOMENT_KINDS = ("dead", "follower", "semitangential")
+
+
+def condensed_fit(model, analysis="static"):
+    """None if the Kirchhoff rod models ``model`` for ``analysis``, else why not (a sentence)."""
+    kin = model.kinematics
+    if analysis != "static":
+        return f"it solves static analyses only, not {analysis!r}"
+    if not kin.finite:
+        return "the kinematics are linear (one linear solve already)"
+    if kin.plane:
+        return "the planar model has as few unknowns per node"
+    if len(model.beams) != 1:
+        return "it models one beam"
+    if len(model.supports) != 1:
+        return "it models a cantilever (one support, clamped)"
+    sup = model.supports[0]
+    if set(sup.fix) != set(DOF_NAMES) or any(sup.displacement) or any(sup.rotation):
+        return "the support is not a clamp with zero displacement and rotation"
+    if sup.history is not None or resolve_point(model, sup.at)[1] != 0.0:
+        return "the clamp is not at the beam's start"
+    if model.distributed_loads or any(model.gravity):
+        return "distributed loads (and gravity) are not implemented in it"
+    if model.springs or model.point_masses:
+        return "springs and point masses are not implemented in it"
+    for ld in model.point_loads:
+        if ld.history is not None:
+            return "a load has a history"
+        if any(ld.moment) and ld.kind not in MOMENT_KINDS:
+            return f"a {ld.kind} moment is not implemented in it (allowed {list(MOMENT_KINDS)})"
+    return None
+
+
+def build_model(model, comm, extra_points=(), condense=False):
+    """The :class:`CondensedModel` of ``model`` if ``condense``, else its
+    :class:`~beamfx.analyses.model.BeamModel`."""
+    from .model import BeamModel
+
+    return (CondensedModel if condense else BeamModel)(model, comm, extra_points=extra_points)
+
+
+class FollowerCoupling:
+    """The follower forces' rank-3 tangent terms and their values from the current rotations."""
+
+    def __init__(self, model, forces):
+        import dolfinx.fem.petsc  # noqa: F401  (fem.petsc)
+        from dolfinx import fem
+
+        self.model, self.forces = model, forces  # [(Constant F, f0, point, G forms)]
+        self.G = [[fem.petsc.create_vector(G_i) for G_i in f[3]] for f in forces]
+        V = model.V
+        self._bc_dofs = np.concatenate([bc.dof_indices()[0] for bc in model.bcs])
+        owned = V.dofmap.index_map.size_local * 3
+        self._rows = np.arange(owned, dtype=np.int32)
+        self._rows_global = V.dofmap.index_map.local_range[0] * 3 + self._rows
+        self._tip = [self._point_dofs(f[2]) for f in forces]
+
+    def _point_dofs(self, at):
+        """Global indices of the three dofs of g at a named point (every rank)."""
+        from dolfinx import fem
+
+        m, V = self.model.mesh.mesh, self.model.V
+        verts = self.model.mesh.point_tags.find(self.model.mesh.points[at][0])
+        local = fem.locate_dofs_topological(V, 0, verts)
+        owned = [d for d in local if d < V.dofmap.index_map.size_local]
+        start = V.dofmap.index_map.local_range[0]
+        mine = [(start + d) * 3 + np.arange(3) for d in owned[:1]]
+        found = [x for part in m.comm.allgather(mine) for x in part]
+        return found[0].astype(np.int32), (owned[0] * 3 + np.arange(3)) if owned else None
+
+    def _g_at(self, dofs):
+        local = dofs[1]
+        g = self.model.w.x.array[local] if local is not None else np.zeros(3)
+        return self.model.comm.allreduce(g if local is not None else np.zeros(3), op=MPI.SUM)
+
+    def update(self):
+        """F = R(g_a) f0 into the constants, from the current rotations."""
+        for (F, f0, _, _), dofs in zip(self.forces, self._tip):
+            F.value[:] = np_exp_rotation(self._g_at(dofs)) @ f0
+
+    def reset(self):
+        for F, f0, _, _ in self.forces:
+            F.value[:] = f0
+
+    def add_to_tangent(self, A):
+        """A −= λ Σ_i G_i ⊗ ∂F_i/∂g_a (rows of this rank; constrained rows left alone)."""
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        lam = float(self.model.load_factor.value)
+        A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        for (_, f0, _, forms), G, dofs in zip(self.forces, self.G, self._tip):
+            dF = self._force_derivative(f0, self._g_at(dofs))  # (3 components, 3 dofs)
+            rows = []
+            for vec, form in zip(G, forms):
+                with vec.localForm() as local:
+                    local.set(0.0)
+                fp.assemble_vector(vec, form)
+                vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+                rows.append(vec.array_r[: len(self._rows)].copy())
+            G_local = np.array(rows).T  # (owned rows, 3)
+            G_local[self._bc_dofs[self._bc_dofs < len(self._rows)]] = 0.0
+            A.setValues(self._rows_global, dofs[0], -lam * G_local @ dF, addv=True)
+        A.assemble()
+
+    @staticmethod
+    def _force_derivative(f0, g, h=1e-7):
+        """∂(exp(ĝ) f0)/∂g by central differences (3 × 3; R is smooth in g)."""
+        out = np.zeros((3, 3))
+        for j in range(3):
+            e = np.zeros(3)
+            e[j] = h
+            out[:, j] = (np_exp_rotation(g + e) - np_exp_rotation(g - e)) @ f0
+        return out / (2 * h)
+
+    def destroy(self):
+        for G in self.G:
+            for v in G:
+                v.destroy()
+
+
+class CondensedModel:
+    """The statically condensed beam of a :class:`~beamfx.analyses.spec.Model` (see the module doc).
+
+    Attributes as :class:`~beamfx.analyses.model.BeamModel` where the solvers and writers use
+    them (``mesh``, ``degree``, ``comm``, ``kin``, ``w``, ``F``, ``J``, ``bcs``,
+    ``load_factor``, ``t0``, ``Lam0``, ``C_M``), plus ``V`` (the space of g), ``coupling``
+    (follower forces, or None) and ``full``, the BeamModel of the same mesh that supplies the
+    frames and stiffnesses (its forms are never compiled).
+    """
+
+    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=()):
+        from dolfinx import fem
+
+        from .model import BeamModel
+
+        why = condensed_fit(model)
+        if why:
+            raise ValueError(f"the statically condensed model does not apply: {why}")
+        self.spec = model
+        kin = Kinematics(
+            finite=True, shear=model.kinematics.shear, stretch=model.kinematics.stretch
+        )
+        self.full = full = BeamModel(replace(model, kinematics=kin), comm, extra_points)
+        self.kin = kin
+        self.mesh, self.comm, self.degree = full.mesh, comm, full.degree
+        self.named, self.raised_degree = full.named, full.raised_degree
+        self.t0, self.Lam0, self.C_N, self.C_M = full.t0, full.Lam0, full.C_N, full.C_M
+        self.load_factor, self.stiffness = full.load_factor, full.stiffness
+        C, kin = full.stiffness, model.kinematics
+        self.compliance = ufl.diag(  # C_N⁻¹, zero where the scene drops stretch or shear
+            ufl.as_vector(
+                [1 / C[0] if kin.stretch else 0.0]
+                + [1 / C[i] if kin.shear else 0.0 for i in (1, 2)]
+            )
+        )
+        m, p = self.mesh.mesh, self.degree
+        self.V = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
+        self.w = fem.Function(self.V, name="rotation_vector")
+        self.u = fem.Function(
+            fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3)),
+            name="displacement",
+        )
+        self.dx = ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p + 2})
+        self.time = 0.0
+        self._build_forms()
+        verts = self.mesh.point_tags.find(self.mesh.points[model.supports[0].at][0])
+        clamp = fem.locate_dofs_topological(self.V, 0, verts)
+        self.bcs = [fem.dirichletbc(np.zeros(3), clamp, self.V)]
+        self.coupling = FollowerCoupling(self, self._followers) if self._followers else None
+        self._integrator = None
+
+    # --- forms ------------------------------------------------------------------------------
+
+    def _before(self, at):
+        """DG0 indicator of the cells between the clamp and the named point."""
+        from .model import _dg0
+
+        s_a = resolve_point(self.spec, at)[1]
+        span = self.mesh.cell_span
+        return _dg0(self.mesh.mesh, (np.max(span, axis=1) <= s_a + 1e-12 * (1 + s_a)) * 1.0)
+
+    def _build_forms(self):
+        from dolfinx import fem
+        from petsc4py import PETSc
+
+        g, v, m = self.w, ufl.TestFunction(self.V), self.mesh.mesh
+        self._forces, self._followers, moments = [], [], 0
+        for ld in self.spec.point_loads:
+            if any(ld.force):
+                F = fem.Constant(m, PETSc.ScalarType((0.0, 0.0, 0.0)))
+                F.value[:] = ld.force
+                self._forces.append((self._before(ld.at), F))
+                if ld.kind == "follower":
+                    self._followers.append(
+                        (F, np.asarray(ld.force, float), ld.at, len(self._forces) - 1)
+                    )
+            if any(ld.moment):
+                moments += self.full._at_point(ld.at, self._moment_work(ld, g, v))
+        n = self.load_factor * self.section_force()
+        Pi = rod.bending_energy(g, self.t0, self.Lam0, self.C_M, self.dx) - rod.load_potential(
+            g, n, self.t0, self.Lam0, self.compliance, self.dx
+        )
+        self.F = ufl.derivative(Pi, g, v) - self.load_factor * moments
+        self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.V))
+        self.work = None  # the residual is not linear in the load factor (arc length: no)
+        # follower forces: ∂F/∂(force at the point), for the tangent's rank-3 term
+        x_dot = rod.position_rate(g, n, self.t0, self.Lam0, self.compliance)
+        self._followers = [
+            (
+                F,
+                f0,
+                at,
+                [
+                    fem.form(
+                        ufl.derivative(self._forces[k][0] * x_dot[i] * self.dx, g, v),
+                        jit_params=_jit(),
+                    )
+                    for i in range(3)
+                ],
+            )
+            for F, f0, at, k in self._followers
+        ]
+
+    def _moment_work(self, ld, g, v):
+        M = ufl.as_vector([float(c) for c in ld.moment])
+        if ld.kind == "semitangential":
+            from ..physics.rotations import quaternion_rotation_vector
+
+            return ufl.derivative(
+                ufl.dot(M, quaternion_rotation_vector(rod.rotation_quaternion(g))), g, v
+            )
+        return ufl.dot(M, rod.virtual_rotation(g, v, spatial=ld.kind == "dead"))
+
+    # --- state ------------------------------------------------------------------------------
+
+    def reset(self):
+        self.w.x.array[:] = 0.0
+        self.u.x.array[:] = 0.0
+        if self.coupling:
+            self.coupling.reset()
+
+    def set_load_factor(self, lam):
+        self.load_factor.value = lam
+
+    def unknowns(self):
+        im = self.V.dofmap.index_map
+        return im.size_global * self.V.dofmap.index_map_bs
+
+    def largest_angle(self):
+        """Largest nodal rotation angle |ψ| (the parametrisation is singular at 2π)."""
+        psi = self.w.x.array.reshape(-1, 3)
+        local = float(np.linalg.norm(psi, axis=1).max(initial=0.0))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
+    def check_state(self):
+        """Raise if a rotation came near 2π, where the rotation vector is no longer valid."""
+        angle = self.largest_angle()
+        if angle > MAX_ANGLE:
+            raise RotationRangeError(
+                f"a section rotated by {np.degrees(angle):.0f} degrees: the statically condensed "
+                f"model (rotation vector) is valid below {np.degrees(MAX_ANGLE):.0f}; set "
+                '[model] condense = "none" for the quaternion model'
+            )
+
+    # --- output -----------------------------------------------------------------------------
+
+    def section_force(self):
+        """n(s) = Σ of the forces beyond s, global axes (statics of the cantilever)."""
+        return sum((before * F for before, F in self._forces), start=ufl.as_vector([0.0] * 3))
+
+    def section_parts(self):
+        """(X, u, quaternion, Λ0, N, M) as UFL, for :func:`beamfx.io._sections.section_expression`."""
+        from ..physics.rotations import rotation
+
+        g = self.w
+        R = rotation(rod.rotation_quaternion(g))
+        N = self.Lam0.T * (R.T * (self.load_factor * self.section_force()))
+        M = self.C_M * rod.curvature(g, self.t0, self.Lam0)
+        X = ufl.SpatialCoordinate(self.mesh.mesh)
+        return X, self.u, rod.rotation_quaternion(g), self.Lam0, N, M
+
+    def sync(self):
+        """Integrate the displacement u = ∫ (R − I) t0 ds from the clamp into ``self.u``.
+
+        Each node's u is the value at its cell's vertex 0 plus ∫₀^ξ (R − I) x_ξ dξ (Gauss, the
+        quadrature of the energy), the vertex values chained from the clamp along the beam.
+        Collective: the per-cell increments of all ranks are allgathered (few cells).
+        """
+        from dolfinx import fem
+
+        V, m = self.u.function_space, self.mesh.mesh
+        xi = np.asarray(V.element.interpolation_points()).reshape(-1)  # node order of a cell
+        if self._integrator is None:
+            gx, gw = np.polynomial.legendre.leggauss(self.degree + 2)
+            points = (xi[:, None] * (gx[None, :] + 1) / 2).reshape(-1, 1)
+            x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| u'
+            n = self.load_factor * self.section_force()
+            x_dot = rod.position_rate(self.w, n, self.t0, self.Lam0, self.compliance)
+            u_xi = ufl.sqrt(ufl.dot(x_xi, x_xi)) * (x_dot - self.t0)
+            expr = fem.Expression(u_xi, points, jit_params=_jit())
+            self._integrator = (expr, gw / 2)
+        expr, gw = self._integrator
+        n = m.topology.index_map(1).size_local
+        vals = expr.eval(np.arange(n, dtype=np.int32)).reshape(n, len(xi), len(gw), 3)
+        inc = xi[None, :, None] * np.einsum("cngi,g->cni", vals, gw)  # vertex 0 -> each node
+        span = self.mesh.cell_span[:n]
+        s_a = span.min(axis=1)
+        x_v0 = m.geometry.x[m.geometry.dofmap.array.reshape(-1, self.degree + 1)[:n, 0]]
+        curve = self.spec.beams[0].curve
+        flipped = np.linalg.norm(x_v0 - curve.points(span.max(axis=1)), axis=1) < np.linalg.norm(
+            x_v0 - curve.points(s_a), axis=1
+        )
+        one = int(np.argmin(np.abs(xi - 1.0)))  # the node at vertex 1
+        step = np.where(flipped[:, None], -inc[:, one], inc[:, one])  # from s_a to s_b
+        parts = self.comm.allgather((s_a, step))
+        offset = sum(len(p[0]) for p in parts[: self.comm.rank])
+        s_all = np.concatenate([p[0] for p in parts])
+        order = np.argsort(s_all, kind="stable")
+        at_s_a = np.zeros((len(s_all), 3))
+        at_s_a[order] = np.cumsum(
+            np.vstack([np.zeros(3), np.concatenate([p[1] for p in parts])[order][:-1]]), axis=0
+        )
+        mine = at_s_a[offset : offset + n]
+        u_v0 = mine + np.where(flipped[:, None], step, 0.0)
+        dofs = V.dofmap.list.array.reshape(-1, len(xi))[:n]
+        self.u.x.array.reshape(-1, 3)[dofs.ravel()] = (u_v0[:, None, :] + inc).reshape(-1, 3)
+        self.u.x.scatter_forward()
+
+
+def _jit():
+    from ..solvers.forms import JIT_PARAMS
+
+    return dict(JIT_PARAMS)

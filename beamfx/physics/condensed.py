@@ -1,0 +1,76 @@
+r"""The statically condensed beam: the rotation field is the only unknown.
+
+In a cantilever under point forces the section force n(s) is the sum of the forces beyond s;
+the strains follow from it, Γ = C_N⁻¹ Λ0ᵀ Rᵀ n, and the centre line from the rotations,
+x' = R (t0 + Λ0 Γ). Eliminating Γ from the Simo–Reissner energy leaves the bending energy and a
+load potential in the rotations alone (:func:`load_potential`): three unknowns per node instead
+of seven (3 displacements and a quaternion), the same answer. With the compliance C_N⁻¹ set to
+zero it is the inextensible, shear-rigid Kirchhoff rod.
+
+The rotation is parametrised by the rotation vector ψ, R = exp(ψ̂) through the quaternion
+(cos(θ/2), sin(θ/2) ψ/θ), θ = |ψ| (a series near θ = 0): a plane bending field is linear in
+s, so polynomials represent a roll-up well; valid for angles below 2π, where the map from ψ
+to R is singular (:data:`~beamfx.analyses.condensed.MAX_ANGLE`).
+"""
+
+import ufl
+
+from .kinematics import d_ds
+from .rotations import body_rate, rotation, spatial_rate
+
+
+def rotation_quaternion(psi):
+    """Unit quaternion (cos(θ/2), sin(θ/2) ψ/θ) of the rotation vector ψ, θ = |ψ|; the Taylor
+    series of both factors below θ² = 1e-6 (error O(θ⁶), no 0/0)."""
+    tt = ufl.dot(psi, psi)
+    theta = ufl.sqrt(tt + 1e-300)
+    small = ufl.lt(tt, 1e-6)
+    c = ufl.conditional(small, 1 - tt / 8 + tt**2 / 384, ufl.cos(theta / 2))
+    s = ufl.conditional(small, 0.5 - tt / 48 + tt**2 / 3840, ufl.sin(theta / 2) / theta)
+    return ufl.as_vector([c, s * psi[0], s * psi[1], s * psi[2]])
+
+
+def curvature(g, t0, Lam0):
+    """K = Λ0ᵀ axial(Rᵀ R') (section axes), as :func:`~beamfx.physics.kinematics.finite_strains`."""
+    q = rotation_quaternion(g)
+    dq = ufl.as_vector([d_ds(q[i], t0) for i in range(4)])
+    return Lam0.T * body_rate(q, dq)
+
+
+def virtual_rotation(g, dg, spatial=True):
+    """δθ of a variation ``dg``: axial(δR Rᵀ) (global axes) or axial(Rᵀ δR) (body axes)."""
+    q = rotation_quaternion(g)
+    dq = ufl.derivative(q, g, dg)
+    return spatial_rate(q, dq) if spatial else body_rate(q, dq)
+
+
+def section_strains(g, n, Lam0, compliance):
+    """Γ = C_N⁻¹ Λ0ᵀ Rᵀ n: the strains that the section force n (global axes) causes."""
+    return compliance * (Lam0.T * (rotation(rotation_quaternion(g)).T * n))
+
+
+def position_rate(g, n, t0, Lam0, compliance):
+    """x' = R (t0 + Λ0 Γ) with Γ from the section force ``n``."""
+    R = rotation(rotation_quaternion(g))
+    return R * (t0 + Lam0 * section_strains(g, n, Lam0, compliance))
+
+
+def load_potential(g, n, t0, Lam0, compliance, dx):
+    r"""∫ n·(R − I) t0 ds + ½ ∫ Γ·C_N Γ ds with Γ = C_N⁻¹ Λ0ᵀ Rᵀ n.
+
+    For a statically determinate beam (a cantilever under point forces) n(s) is the sum of
+    the forces beyond s. The Simo–Reissner energy ½ K·C_M K + ½ Γ·C_N Γ − Σ F·u(s_a), with
+    u(s_a) = ∫₀^{s_a} (R(t0 + Λ0 Γ) − t0) ds, is stationary in Γ at C_N Γ = Λ0ᵀ Rᵀ n; putting
+    that Γ back leaves ½ K·C_M K minus this potential: the same equilibrium with the
+    rotations as the only unknowns (exact, not an approximation: shear and stretch are kept).
+    With the compliance zero it is the Kirchhoff rod's −Σ F·u(s_a).
+    """
+    Gamma = section_strains(g, n, Lam0, compliance)
+    R = rotation(rotation_quaternion(g))
+    return (ufl.dot(n, (R - ufl.Identity(3)) * t0) + 0.5 * ufl.dot(Gamma, Lam0.T * (R.T * n))) * dx
+
+
+def bending_energy(g, t0, Lam0, C_M, dx):
+    """½ K·C_M K: the whole strain energy of the Kirchhoff rod."""
+    K = curvature(g, t0, Lam0)
+    return 0.5 * ufl.dot(K, C_M * K) * dx
