@@ -13,16 +13,19 @@ from beamfx.scene import load_scene
 pytestmark = pytest.mark.mpi
 
 
+@pytest.mark.parametrize("condensed", [False, True])
 @pytest.mark.parametrize("follower", [False, True])
-def test_bend45_probes_match_serial(follower):
+def test_bend45_probes_match_serial(follower, condensed):
     from dataclasses import replace
+
+    from beamfx.analyses.condensed import build_model
 
     spec = load_scene(default_scene_path()).model
     kind = "follower" if follower else "dead"
     spec = replace(spec, point_loads=tuple(replace(p, kind=kind) for p in spec.point_loads))
     out = {}
     for comm in (MPI.COMM_SELF, MPI.COMM_WORLD):
-        model = BeamModel(spec, comm, extra_points=["bend:end", "bend:0.5"])
+        model = build_model(spec, comm, ["bend:end", "bend:0.5"], condensed)
         solve_static(model, steps=10)
         out[comm.size] = evaluate_points(model, ["bend:end", "bend:0.5"])
     parallel, serial = out[MPI.COMM_WORLD.size], out[1]
