@@ -38,6 +38,7 @@ bench-peers: install
 	$(PY) -m beamfx.bench.peers export $(PEERS)
 	.venv-peers/bin/python peers/exudyn_cases.py $(PEERS)
 	.venv-peers/bin/python peers/elastica_cases.py $(PEERS)
+	.venv-peers/bin/python peers/calculix_cases.py $(PEERS)
 	$(PY) -m beamfx.bench.peers $(PEERS) docs/validation
 
 lint: install

@@ -1,11 +1,22 @@
 #!/usr/bin/env bash
 # Peer codes for `make bench-peers`, in their own venv: no system site packages,
-# so their numpy (and its BLAS) is independent of the one DOLFINx uses.
+# so their numpy (and its BLAS) is independent of the one DOLFINx uses. CalculiX (`ccx`)
+# comes from Debian (apt-get, with sudo unless root).
 # Idempotent: a second run with everything in place takes about a second.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${PEERS_VENV:-.venv-peers}
 PKGS=(exudyn pyelastica numpy matplotlib)
+
+# CalculiX (Debian `calculix-ccx`, binary `ccx`): checked before the fast path below
+if ! command -v ccx >/dev/null 2>&1; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; fi
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends calculix-ccx \
+    || { $SUDO apt-get update -q && $SUDO env DEBIAN_FRONTEND=noninteractive \
+      apt-get install -y --no-install-recommends calculix-ccx; }
+  echo "peers: ccx $(dpkg-query -W -f='${Version}' calculix-ccx 2>/dev/null || echo '?')"
+fi
 
 if [ ! -x "$VENV/bin/python" ]; then
   /usr/bin/python3 -m venv "$VENV"
