@@ -44,7 +44,7 @@ MOMENT_KINDS = ("dead", "follower", "semitangential")
 
 
 def condensed_fit(model, analysis="static"):
-    """None if the Kirchhoff rod models ``model`` for ``analysis``, else why not (a sentence)."""
+    """None if the condensed model applies to ``model`` and ``analysis``, else why not."""
     kin = model.kinematics
     if analysis != "static":
         return f"it solves static analyses only, not {analysis!r}"
@@ -111,9 +111,10 @@ class FollowerCoupling:
         return found[0].astype(np.int32), (owned[0] * 3 + np.arange(3)) if owned else None
 
     def _g_at(self, dofs):
+        """The rotation vector at a point, from the rank that owns it (collective)."""
         local = dofs[1]
         g = self.model.w.x.array[local] if local is not None else np.zeros(3)
-        return self.model.comm.allreduce(g if local is not None else np.zeros(3), op=MPI.SUM)
+        return self.model.comm.allreduce(g, op=MPI.SUM)
 
     def update(self):
         """F = R(g_a) f0 into the constants, from the current rotations."""
@@ -199,12 +200,8 @@ class CondensedModel:
         m, p = self.mesh.mesh, self.degree
         self.V = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
         self.w = fem.Function(self.V, name="rotation_vector")
-        self.u = fem.Function(
-            fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3)),
-            name="displacement",
-        )
+        self.u = fem.Function(self.V, name="displacement")  # derived: :meth:`sync`
         self.dx = ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p + 2})
-        self.time = 0.0
         self._build_forms()
         verts = self.mesh.point_tags.find(self.mesh.points[model.supports[0].at][0])
         clamp = fem.locate_dofs_topological(self.V, 0, verts)
@@ -226,17 +223,18 @@ class CondensedModel:
         from dolfinx import fem
         from petsc4py import PETSc
 
+        from ..solvers.forms import compile_form
+
         g, v, m = self.w, ufl.TestFunction(self.V), self.mesh.mesh
-        self._forces, self._followers, moments = [], [], 0
+        self._forces, followers, moments = [], [], 0
         for ld in self.spec.point_loads:
             if any(ld.force):
                 F = fem.Constant(m, PETSc.ScalarType((0.0, 0.0, 0.0)))
                 F.value[:] = ld.force
-                self._forces.append((self._before(ld.at), F))
+                before = self._before(ld.at)
+                self._forces.append((before, F))
                 if ld.kind == "follower":
-                    self._followers.append(
-                        (F, np.asarray(ld.force, float), ld.at, len(self._forces) - 1)
-                    )
+                    followers.append((F, np.asarray(ld.force, float), ld.at, before))
             if any(ld.moment):
                 moments += self.full._at_point(ld.at, self._moment_work(ld, g, v))
         n = self.load_factor * self.section_force()
@@ -246,22 +244,16 @@ class CondensedModel:
         self.F = ufl.derivative(Pi, g, v) - self.load_factor * moments
         self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.V))
         self.work = None  # the residual is not linear in the load factor (arc length: no)
-        # follower forces: ∂F/∂(force at the point), for the tangent's rank-3 term
-        x_dot = rod.position_rate(g, n, self.t0, self.Lam0, self.compliance)
+        self.x_dot = rod.position_rate(g, n, self.t0, self.Lam0, self.compliance)
+        # follower forces: ∂(residual)/∂(force at the point), for the tangent's rank-3 term
         self._followers = [
             (
                 F,
                 f0,
                 at,
-                [
-                    fem.form(
-                        ufl.derivative(self._forces[k][0] * x_dot[i] * self.dx, g, v),
-                        jit_params=_jit(),
-                    )
-                    for i in range(3)
-                ],
+                [compile_form(ufl.derivative(before * x * self.dx, g, v)) for x in self.x_dot],
             )
-            for F, f0, at, k in self._followers
+            for F, f0, at, before in followers
         ]
 
     def _moment_work(self, ld, g, v):
@@ -323,36 +315,32 @@ class CondensedModel:
         return X, self.u, rod.rotation_quaternion(g), self.Lam0, N, M
 
     def sync(self):
-        """Integrate the displacement u = ∫ (R − I) t0 ds from the clamp into ``self.u``.
+        """Integrate the displacement u = ∫ (x' − t0) ds from the clamp into ``self.u``.
 
-        Each node's u is the value at its cell's vertex 0 plus ∫₀^ξ (R − I) x_ξ dξ (Gauss, the
-        quadrature of the energy), the vertex values chained from the clamp along the beam.
+        Each node's u is the value at its cell's vertex 0 plus ∫₀^ξ u_ξ dξ (Gauss, p + 2
+        points), the vertex values chained from the clamp along the beam.
         Collective: the per-cell increments of all ranks are allgathered (few cells).
         """
         from dolfinx import fem
 
-        V, m = self.u.function_space, self.mesh.mesh
+        from ..solvers.forms import JIT_PARAMS
+
+        V, m = self.V, self.mesh.mesh
         xi = np.asarray(V.element.interpolation_points()).reshape(-1)  # node order of a cell
         if self._integrator is None:
             gx, gw = np.polynomial.legendre.leggauss(self.degree + 2)
             points = (xi[:, None] * (gx[None, :] + 1) / 2).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| u'
-            n = self.load_factor * self.section_force()
-            x_dot = rod.position_rate(self.w, n, self.t0, self.Lam0, self.compliance)
-            u_xi = ufl.sqrt(ufl.dot(x_xi, x_xi)) * (x_dot - self.t0)
-            expr = fem.Expression(u_xi, points, jit_params=_jit())
-            self._integrator = (expr, gw / 2)
-        expr, gw = self._integrator
+            u_xi = ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.t0)
+            expr = fem.Expression(u_xi, points, jit_params=dict(JIT_PARAMS))
+            s_ends = self.full._cell_arc_lengths([0.0, 1.0])  # arc length at vertex 0 and 1
+            self._integrator = (expr, gw / 2, s_ends)
+        expr, gw, s_ends = self._integrator
         n = m.topology.index_map(1).size_local
         vals = expr.eval(np.arange(n, dtype=np.int32)).reshape(n, len(xi), len(gw), 3)
         inc = xi[None, :, None] * np.einsum("cngi,g->cni", vals, gw)  # vertex 0 -> each node
-        span = self.mesh.cell_span[:n]
-        s_a = span.min(axis=1)
-        x_v0 = m.geometry.x[m.geometry.dofmap.array.reshape(-1, self.degree + 1)[:n, 0]]
-        curve = self.spec.beams[0].curve
-        flipped = np.linalg.norm(x_v0 - curve.points(span.max(axis=1)), axis=1) < np.linalg.norm(
-            x_v0 - curve.points(s_a), axis=1
-        )
+        s_a = s_ends[:n].min(axis=1)
+        flipped = s_ends[:n, 0] > s_ends[:n, 1]  # DOLFINx reversed the cell
         one = int(np.argmin(np.abs(xi - 1.0)))  # the node at vertex 1
         step = np.where(flipped[:, None], -inc[:, one], inc[:, one])  # from s_a to s_b
         parts = self.comm.allgather((s_a, step))
@@ -368,9 +356,3 @@ class CondensedModel:
         dofs = V.dofmap.list.array.reshape(-1, len(xi))[:n]
         self.u.x.array.reshape(-1, 3)[dofs.ravel()] = (u_v0[:, None, :] + inc).reshape(-1, 3)
         self.u.x.scatter_forward()
-
-
-def _jit():
-    from ..solvers.forms import JIT_PARAMS
-
-    return dict(JIT_PARAMS)

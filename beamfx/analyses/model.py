@@ -10,7 +10,14 @@ from mpi4py import MPI
 
 from ..geometry import BeamSpec, build_mesh
 from ..physics import energy
-from ..physics.kinematics import displacement, rotation_vector, section_frame, strains, tangent
+from ..physics.kinematics import (
+    displacement,
+    rotation_output,
+    rotation_vector,
+    section_frame,
+    strains,
+    tangent,
+)
 from ..physics.rotations import np_quaternion
 from .checks import joint_breaks
 from .spec import DOF_NAMES, resolve_point
@@ -379,6 +386,32 @@ class BeamModel:
         for c, history in self._load_histories:
             c.value = float(history(t))
         self.set_load_factor(float(self.load_factor.value))
+
+    # --- what solvers and writers ask of every model (CondensedModel answers differently) ---
+
+    #: a non-local term the forms cannot hold (:class:`~beamfx.solvers.NewtonSolver` ``coupling``)
+    coupling = None
+
+    def check_state(self):
+        """Raise if the state left the model's range: never (quaternions cover any rotation)."""
+
+    def sync(self):
+        """Bring derived fields up to date before output: none (u is an unknown)."""
+
+    def section_parts(self):
+        """(X, u, rotation output, Λ0, N = C_N Γ, M = C_M K) as UFL, for
+        :func:`beamfx.io._sections.section_expression`."""
+        u, rot = ufl.split(self.w)
+        Gamma, K = strains(self.kin, u, rot, self.t0, self.Lam0)
+        X = ufl.SpatialCoordinate(self.mesh.mesh)
+        return (
+            X,
+            displacement(self.kin, u),
+            rotation_output(self.kin, rot),
+            self.Lam0,
+            self.C_N * Gamma,
+            self.C_M * K,
+        )
 
     def unknowns(self):
         """Global number of unknowns."""

@@ -70,9 +70,8 @@ def solve_static(
     from ..solvers.forms import compile_seconds
 
     c0 = compile_seconds[0]
-    coupling = getattr(model, "coupling", None)
     solver = solver or NewtonSolver(
-        model.F, model.J, model.w, model.bcs, prefix, options, coupling=coupling
+        model.F, model.J, model.w, model.bcs, prefix, options, coupling=model.coupling
     )
     scale = load_scale(model, solver.F)
     solver.set_atol(max(1e-10 * scale, 1e-14))
@@ -81,7 +80,7 @@ def solve_static(
     def solve_at(lam):
         model.set_load_factor(lam)
         report = solver.solve()
-        if report.converged and hasattr(model, "check_state"):
+        if report.converged:
             model.check_state()  # e.g. the condensed model's range of rotations: raises
         return report
 

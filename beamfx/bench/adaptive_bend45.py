@@ -85,7 +85,7 @@ class AdaptiveCase(Case):
             model.w,
             model.bcs,
             "beamfx_bench_adaptive_",
-            coupling=getattr(model, "coupling", None),
+            coupling=model.coupling,
         )
         model.reset()
         solve_static(model, steps=steps, solver=solver)  # first use of this solver

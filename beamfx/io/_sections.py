@@ -24,7 +24,6 @@ import weakref
 import numpy as np
 import ufl
 
-from ..physics.kinematics import displacement, rotation_output, strains
 from ..physics.rotations import np_exp_rotation, np_rotation
 from ..solvers.forms import JIT_PARAMS
 
@@ -42,14 +41,7 @@ def _layout(kin):
 
 def section_expression(model):
     """Flat UFL vector of the quantities in the module table, and its layout (name -> slice)."""
-    if hasattr(model, "section_parts"):  # a model with its own kinematics (Kirchhoff rod)
-        parts = list(model.section_parts())
-    else:
-        u, rot = ufl.split(model.w)
-        Gamma, K = strains(model.kin, u, rot, model.t0, model.Lam0)
-        X = ufl.SpatialCoordinate(model.mesh.mesh)
-        N, M = model.C_N * Gamma, model.C_M * K
-        parts = [X, displacement(model.kin, u), rotation_output(model.kin, rot), model.Lam0, N, M]
+    parts = model.section_parts()
     flat = [p[index] for p in parts for index in np.ndindex(p.ufl_shape)]  # row-major
     layout, size = _layout(model.kin)
     assert len(flat) == size  # internal consistency of the table above

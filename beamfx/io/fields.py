@@ -28,8 +28,7 @@ def nodal_fields(model, recover=True):
         index of each point (n,); ``cells`` the (cells·k, 2) line segments of the polyline.
         None on the other ranks.
     """
-    if hasattr(model, "sync"):  # displacement integrated from the rotations (Kirchhoff rod)
-        model.sync()
+    model.sync()  # derived fields (the condensed model integrates its displacement)
     m = model.mesh.mesh
     k = model.degree
     xi = np.linspace(0.0, 1.0, k + 1)[:, None]

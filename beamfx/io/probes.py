@@ -84,8 +84,7 @@ def evaluate_points(model, names=None, recover=True):
     unknown = [n for n in names if n not in model.mesh.points]
     if unknown:
         raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
-    if hasattr(model, "sync"):  # displacement integrated from the rotations (Kirchhoff rod)
-        model.sync()
+    model.sync()  # derived fields (the condensed model integrates its displacement)
     model.mesh.mesh.topology.create_connectivity(0, 1)
 
     found = [(n, _locate(model, n)) for n in names]
