@@ -142,10 +142,14 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
             None, evaluate_points(model, list(scene.probes.values()))
         )
     else:
-        try:
-            result = solve_static(
+
+        def static(model):
+            return solve_static(
                 model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
             )
+
+        try:
+            result = static(model)
         except (RotationRangeError, SolveFailed) as e:
             if not scene.condense:
                 raise
@@ -154,9 +158,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
             model = build_model(scene.model, comm, extra_points, False)
             latest.clear()
             write.resume(0.0)  # drop the failed attempt's frames
-            result = solve_static(
-                model, steps=scene.steps, options=scene.solver_options, on_step=on_step, log=log
-            )
+            result = static(model)
     final = latest["probes"]
     results = {
         "scene": str(path),
