@@ -58,10 +58,6 @@ class PointLoad:
     history: object = None  # f(t) scaling force and moment in a transient (None: 1)
     arm: tuple | None = None
 
-    @property
-    def follower(self):
-        return self.kind == "follower"
-
 
 @dataclass(frozen=True)
 class DistributedLoad:
@@ -74,10 +70,6 @@ class DistributedLoad:
     kind: str = "dead"
     history: object = None  # f(t) scaling force and moment in a transient (None: 1)
     arm: tuple | None = None
-
-    @property
-    def follower(self):
-        return self.kind == "follower"
 
 
 @dataclass(frozen=True)
