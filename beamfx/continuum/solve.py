@@ -237,7 +237,7 @@ class ContinuumBeam:
         that kind (:data:`KINDS`) among the ``per_target`` nearest ω_target² (shift-and-invert
         there, so rigid-body modes at 0 are never reached). Returns ({name: ω}, seconds)."""
         from ..analyses.modal import assemble_pair
-        from ..solvers.eigen import solve_eigen
+        from ..solvers.eigen import frequencies_by_kind
 
         t = time.perf_counter()
         self.load_factor.value = 0.0
@@ -245,18 +245,15 @@ class ContinuumBeam:
         K, M = assemble_pair(compile_form(self.J), compile_form(self.mass()), self.bcs)
         setup_s = time.perf_counter() - t
         kind_forms = self._kind_forms()
-        out = {}
-        for name, (kind, omega) in targets.items():
-            pairs = solve_eigen(K, M, per_target, omega**2, "beamfx_continuum_eigen_")
-            found = []
-            for lam, x in zip(pairs.values.real, pairs.vectors):
-                self.w.vector.array[:] = x.array
-                self.w.x.scatter_forward()
-                found.append((abs(lam - omega**2), np.sqrt(abs(lam)), self._kind(kind_forms)))
-                x.destroy()
-            match = sorted(f for f in found if f[2] == kind)
-            out[name] = match[0][1] if match else float("nan")
-        self.w.x.array[:] = 0.0
+        out = frequencies_by_kind(
+            K,
+            M,
+            self.w,
+            targets,
+            lambda: self._kind(kind_forms),
+            per_target,
+            "beamfx_continuum_eigen_",
+        )
         K.destroy()
         M.destroy()
         return out, {"setup_s": setup_s, "solve_s": time.perf_counter() - t - setup_s}

@@ -8,7 +8,6 @@ AMG (GAMG) and the six rigid-body modes as the matrix's near-nullspace.
 import time
 from dataclasses import dataclass, field
 
-import numpy as np
 import ufl
 
 from ..solvers.forms import compile_form
@@ -178,11 +177,11 @@ class Solid:
 
         ``targets`` {name: (kind, ω_target)} with kind "axial", "torsion" or "bending"; the
         kind of a mode is read from where its kinetic energy lies (:func:`mode_kind`).
-        Shift-and-invert at each target with MUMPS (:func:`beamfx.solvers.eigen.solve_eigen`).
+        Shift-and-invert at each target with MUMPS (:func:`beamfx.solvers.eigen.frequencies_by_kind`).
         """
         import dolfinx.fem.petsc as fp
 
-        from ..solvers.eigen import solve_eigen
+        from ..solvers.eigen import frequencies_by_kind
         from ..solvers.forms import compile_form
 
         v, du = ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
@@ -194,18 +193,16 @@ class Solid:
         )
         K.assemble()
         M.assemble()
-        kinds, out = self._kind_forms(), {}
-        for name, (kind, omega) in targets.items():
-            pairs = solve_eigen(K, M, per_target, omega**2, "beamfx_solid_eigen_")
-            found = []
-            for lam, x in zip(pairs.values.real, pairs.vectors):
-                self.u.vector.array[:] = x.array
-                self.u.x.scatter_forward()
-                found.append((abs(lam - omega**2), np.sqrt(abs(lam)), mode_kind(kinds, self.comm)))
-                x.destroy()
-            match = sorted(f for f in found if f[2] == kind)
-            out[name] = match[0][1] if match else float("nan")
-        self.u.x.array[:] = 0.0
+        kinds = self._kind_forms()
+        out = frequencies_by_kind(
+            K,
+            M,
+            self.u,
+            targets,
+            lambda: mode_kind(kinds, self.comm),
+            per_target,
+            "beamfx_solid_eigen_",
+        )
         K.destroy()
         M.destroy()
         return out

@@ -91,3 +91,23 @@ def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=N
         its,
         time.perf_counter() - t,
     )
+
+
+def frequencies_by_kind(K, M, w, targets, kind_of, per_target, prefix):
+    """For each name → (kind, ω_target): ω of the mode of that kind among the ``per_target``
+    eigenpairs nearest ω_target² (shift-and-invert there, so rigid modes at 0 are never
+    reached); NaN if none is of that kind. Each eigenvector is put into the Function ``w``
+    for ``kind_of()`` to classify (collective); ``w`` is zero afterwards."""
+    out = {}
+    for name, (kind, omega) in targets.items():
+        pairs = solve_eigen(K, M, per_target, omega**2, prefix)
+        found = []
+        for lam, x in zip(pairs.values.real, pairs.vectors):
+            w.vector.array[:] = x.array
+            w.x.scatter_forward()
+            found.append((abs(lam - omega**2), np.sqrt(abs(lam)), kind_of()))
+            x.destroy()
+        match = sorted(f for f in found if f[2] == kind)
+        out[name] = match[0][1] if match else float("nan")
+    w.x.array[:] = 0.0
+    return out
