@@ -6,6 +6,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..solvers import NewtonSolver, step_load
+from ..solvers.stepping import SavedState
 
 
 class StaticResult(NamedTuple):
@@ -15,19 +16,12 @@ class StaticResult(NamedTuple):
     # triangular_solve, python), total
 
 
-class _State:
+class _State(SavedState):
     """Save/restore of the unknowns for cut-backs, and the secant predictor."""
 
     def __init__(self, w):
-        self.w, self.saved = w, w.x.array.copy()
+        super().__init__(w)
         self.last = self.previous = None  # (load factor, unknowns) of converged states
-
-    def save(self):
-        self.saved[:] = self.w.x.array
-
-    def restore(self):
-        self.w.x.array[:] = self.saved
-        self.w.x.scatter_forward()
 
     def predict(self, lam, target):
         """Start Newton from the secant through the last two converged states,

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import ufl
 
+from ..physics.kinematics import d_ds
 from ..solvers.forms import compile_form
 from . import model as forms
 
@@ -113,11 +114,7 @@ class ContinuumBeam:
         """(r_s, d2, d3, d2_s, d3_s) of increments ``w`` (UFL), straight reference."""
         t0, e2, e3 = self.frame_ufl
         u, a2, a3 = split(w)
-
-        def d_ds(f):
-            return ufl.dot(ufl.grad(f), t0)
-
-        return t0 + d_ds(u), e2 + a2, e3 + a3, d_ds(a2), d_ds(a3)
+        return t0 + d_ds(u, t0), e2 + a2, e3 + a3, d_ds(a2, t0), d_ds(a3, t0)
 
     def energy(self):
         """Π_int = ∫ ψ̂ ds, ψ̂ the section-integrated energy of the variant (axis part with
@@ -192,6 +189,7 @@ class ContinuumBeam:
         reference (the linear answer: SVK Hessian at w = 0 and the dead load). Returns a dict
         (load steps, Newton iterations, seconds)."""
         from ..solvers import LoadStep, NewtonSolver, SolveFailed, step_load
+        from ..solvers.stepping import SavedState
 
         if linear and self.spec.follower:
             raise ValueError("a linear solve takes the load in the reference axes: follower=False")
@@ -216,6 +214,8 @@ class ContinuumBeam:
                 raise SolveFailed(f"linear solve failed: {report.reason}")
             history = [LoadStep(1, 1.0, 1, report.residuals, 0)]
         else:
+            # no predictor: a secant extrapolation of the section vectors stretches them like
+            # a linearised rotation (roll-up: 23 -> 26-36 Newton iterations per step of 45°)
             history = step_load(solve_at, SavedState(self.w), steps=steps, log=log)
         solve_s = time.perf_counter() - t1
         solver.destroy()
@@ -282,22 +282,6 @@ class ContinuumBeam:
 
         share = {k: self.comm.allreduce(fem.assemble_scalar(f)) for k, f in kind_forms.items()}
         return max(share, key=share.get)
-
-
-class SavedState:
-    """Save/restore of the unknowns for load-step cut-backs. No predictor: a secant
-    extrapolation of the section vectors stretches them like a linearised rotation, and cost
-    Newton iterations in the roll-up (23 → 26–36 per step of 45°)."""
-
-    def __init__(self, w):
-        self.w, self.saved = w, w.x.array.copy()
-
-    def save(self):
-        self.saved[:] = self.w.x.array
-
-    def restore(self):
-        self.w.x.array[:] = self.saved
-        self.w.x.scatter_forward()
 
 
 def split(w):

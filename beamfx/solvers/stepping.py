@@ -5,6 +5,20 @@ from typing import NamedTuple
 from .snes import SolveFailed
 
 
+class SavedState:
+    """Save/restore of the unknowns in the Function ``w``, for :func:`step_load`'s cut-backs."""
+
+    def __init__(self, w):
+        self.w, self.saved = w, w.x.array.copy()
+
+    def save(self):
+        self.saved[:] = self.w.x.array
+
+    def restore(self):
+        self.w.x.array[:] = self.saved
+        self.w.x.scatter_forward()
+
+
 class LoadStep(NamedTuple):
     step: int
     load_factor: float
