@@ -9,7 +9,11 @@ def main(argv=None):
         prog="beamfx", description="Geometrically exact 3D beams on FEniCSx."
     )
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("run", help="solve a scene (the built-in 45-degree bend if none is given)")
+    p = sub.add_parser(
+        "run",
+        help="solve a scene (the built-in 45-degree bend if none is given); a scene with "
+        "[[sweep]] tables runs as an ensemble across the MPI ranks",
+    )
     p.add_argument("scene", nargs="?")
     p.add_argument("--out", help="output folder (default: the scene's [output] dir)")
     p.add_argument(
@@ -49,14 +53,26 @@ def main(argv=None):
         if args.command == "run":
             from .runner import run_scene
 
-            run_scene(
+            results = run_scene(
                 args.scene, args.out, restart=args.restart, png=args.png, animate=args.animate
             )
+            failed = [m["member"] for m in results.get("members", []) if m["status"] != "converged"]
+            if failed:  # a sweep: the table is written, but say that it has holes
+                print(f"beamfx: sweep members {failed} failed (see sweep.md)", file=sys.stderr)
+                return 3
         elif args.command == "check":
             from .runner import check_scene
 
             scene = check_scene(args.scene)
-            print(f"{args.scene}: OK ({len(scene.model.beams)} beam(s), analysis {scene.analysis})")
+            if hasattr(scene, "members"):
+                first = scene.members[0].scene
+                print(
+                    f"{args.scene}: OK (a sweep of {len(scene.members)} scenes over "
+                    f"{', '.join(scene.keys)}; analysis {first.analysis})"
+                )
+            else:
+                n = len(scene.model.beams)
+                print(f"{args.scene}: OK ({n} beam(s), analysis {scene.analysis})")
         elif args.command == "solid":
             from .solid.run import SolidMesh, run_solid
 

@@ -3,6 +3,7 @@
 import os
 import time
 from dataclasses import replace
+from functools import partial
 from importlib import resources
 from pathlib import Path
 
@@ -14,8 +15,22 @@ def default_scene_path():
     return Path(str(resources.files("beamfx") / "scenes" / DEFAULT_SCENE))
 
 
-def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, animate=False):
+def run_scene(
+    path=None,
+    out_dir=None,
+    log=None,
+    restart=False,
+    png=False,
+    animate=False,
+    comm=None,
+    scene=None,
+):
     """Solve the scene at ``path`` (built-in default if None); return the results dict.
+
+    A file with ``[[sweep]]`` tables is a family of scenes: it runs as an ensemble
+    (:func:`beamfx.sweep.run_sweep`) and the sweep's summary is returned instead.
+    ``comm`` (default: all ranks) is the communicator the scene is solved on; ``scene`` an
+    already-parsed scene (then ``path`` only names it in the results).
 
     With ``png`` (or ``animate``: a GIF of a transient's frames too) pictures of the results
     are rendered into the output folder after the solve (:mod:`beamfx.io.pictures`).
@@ -43,13 +58,21 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
     from .scene import load_scene
     from .solvers import SolveFailed
 
-    log = log or default_log
-    comm = MPI.COMM_WORLD
+    comm = comm or MPI.COMM_WORLD
+    log = log or partial(default_log, comm=comm)
     t_start = time.perf_counter()
     path = Path(path) if path else default_scene_path()
-    scene = load_scene(path)
+    if scene is None:
+        from .scene import load_sweep
+
+        sweep = load_sweep(path)
+        if sweep is not None:
+            from .sweep import run_sweep
+
+            return run_sweep(sweep, out_dir, log=log, png=png, comm=comm)
+        scene = load_scene(path)
     out = Path(out_dir or scene.output_dir)
-    check_writable(out)
+    check_writable(out, comm)
     results_file = out / "results.json"
     if comm.rank == 0 and results_file.exists():
         os.remove(results_file)
@@ -87,11 +110,11 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
             f"the only unknowns, 3 per node instead of {per_node}, {model.unknowns()} instead of "
             f"{model.unknowns() // 3 * per_node}; shear and stretch kept"
         )
-    pvd, xdmf = PvdSeries(out / "deformed.pvd"), XdmfSeries(out / "deformed.xdmf")
+    pvd, xdmf = PvdSeries(out / "deformed.pvd", comm), XdmfSeries(out / "deformed.xdmf", comm)
     names = [b.name for b in scene.model.beams]
     outlines = model_outlines(scene.model.beams)
-    surface = SurfaceSeries(out / "surface.pvd", model.degree, names, outlines)
-    write_paraview_script(out)
+    surface = SurfaceSeries(out / "surface.pvd", model.degree, names, outlines, comm=comm)
+    write_paraview_script(out, comm)
     if png or animate:
         from .io.pictures import write_undeformed
 
@@ -102,7 +125,7 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
         """ParaView files of the current state as step ``step`` at ``time``."""
         fields = nodal_fields(model)
         vtu = out / f"deformed_{step:04d}.vtu"
-        write_vtu(vtu, fields)
+        write_vtu(vtu, fields, comm)
         pvd.add(time, vtu)
         xdmf.add(time, fields)
         surface.add(step, time, fields)
@@ -201,8 +224,8 @@ def run_scene(path=None, out_dir=None, log=None, restart=False, png=False, anima
     if png or animate:
         from .io.pictures import write_pictures
 
-        results["pictures"] = write_pictures(out, results, log, animate)
-    write_json_atomic(results_file, results)
+        results["pictures"] = write_pictures(out, results, log, animate, comm=comm)
+    write_json_atomic(results_file, results, comm)
     log(f"done in {results['wall_time_s']['run']:.2f} s; results in {results_file}")
     if refinement:
         estimate = f"{refinement.estimate:.3g}" if refinement.estimate is not None else "none"
@@ -223,21 +246,20 @@ def _trace(model, scene, out, on_step, log):
     """Arc-length continuation of a scene; the path is written to ``path.csv`` as it goes."""
     from types import SimpleNamespace
 
-    from mpi4py import MPI
-
     from .analyses.continuation import limit_points, trace_path
     from .solvers.arclength import ArcLengthSettings
 
     settings = dict(scene.settings)
     method = settings.pop("method")
     csv = out / "path.csv"
-    if MPI.COMM_WORLD.rank == 0:
+    root = model.comm.rank == 0
+    if root:
         csv.write_text("step,load_factor,ux,uy,uz,arc_length,iterations\n")
 
     def record(point):
         step = SimpleNamespace(step=len(record.points), load_factor=point.load_factor)
         record.points.append(point)
-        if MPI.COMM_WORLD.rank == 0:
+        if root:
             with csv.open("a") as f:
                 u = ",".join(f"{x:.12g}" for x in point.displacement)
                 f.write(
@@ -278,10 +300,12 @@ def _trace(model, scene, out, on_step, log):
 
 
 def check_scene(path):
-    """Validate a scene without solving: keys, types, points, supports."""
+    """Validate a scene without solving: keys, types, points, supports; for a sweep file every
+    member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
     from .analyses.checks import check_supported
-    from .scene import load_scene
+    from .scene import load_scene, load_sweep
 
-    scene = load_scene(path)
-    check_supported(scene.model)
-    return scene
+    sweep = load_sweep(path)
+    for scene in [m.scene for m in sweep.members] if sweep else [load_scene(path)]:
+        check_supported(scene.model)
+    return sweep or scene

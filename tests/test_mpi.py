@@ -86,3 +86,50 @@ def test_transient_matches_serial():
 
     serial, parallel = _serial_and_parallel(run)
     assert np.allclose(parallel, serial, rtol=1e-8, atol=1e-10), (parallel, serial)
+
+
+def _shared_folder():
+    """One temporary folder for all ranks (pytest's tmp_path differs between ranks)."""
+    import tempfile
+    from pathlib import Path
+
+    name = tempfile.mkdtemp(prefix="beamfx_mpi_") if MPI.COMM_WORLD.rank == 0 else None
+    return Path(MPI.COMM_WORLD.bcast(name))
+
+
+@pytest.mark.parametrize(
+    "values", [[[0, 0, 150], [0, 0, 300], [0, 0, 600]], [[0, 0, 600]]], ids=["3-members", "1"]
+)
+def test_sweep_ensemble_matches_serial(values):
+    """A sweep on split communicators (3 members: groups of one rank; 1 member: one group of
+    all ranks) gives the probes each member's scene gives on one process."""
+    import json
+
+    from beamfx.runner import run_scene
+    from beamfx.scene import parse_sweep
+    from beamfx.sweep import run_sweep
+
+    data = {**load_scene_data(), "sweep": [{"key": "loads[0].force", "values": values}]}
+    data["model"] = {"condense": "none"}  # the quaternion model (the condensed one: above)
+    sweep = parse_sweep(json.loads(json.dumps(data)), "sweep.toml")
+    folder = _shared_folder()
+    table = run_sweep(sweep, folder / "ensemble")
+    assert table["groups"] == min(len(values), MPI.COMM_WORLD.size)
+    for row, member in zip(table["members"], sweep.members):
+        assert row["status"] == "converged"
+        assert row["ranks"] == MPI.COMM_WORLD.size // table["groups"]
+        alone = run_scene(
+            "alone.toml",
+            folder / f"alone_{member.index}_rank{MPI.COMM_WORLD.rank}",  # each rank alone
+            comm=MPI.COMM_SELF,
+            scene=member.scene,
+        )
+        for what in ("displacement", "rotation_vector"):
+            a, b = np.asarray(row["probes"]["tip"][what]), np.asarray(alone["probes"]["tip"][what])
+            assert np.allclose(a, b, rtol=1e-9, atol=1e-9 * np.abs(b).max()), (what, a, b)
+
+
+def load_scene_data():
+    import tomllib
+
+    return tomllib.loads(default_scene_path().read_text())

@@ -44,7 +44,7 @@ def run_rotating(model, scene, write, log, out):
         log=log,
     )
     frame.destroy()
-    write_campbell(result, out)
+    write_campbell(result, out, model.comm)
     branches = [
         {
             "branch": b + 1,

@@ -123,7 +123,7 @@ def run_transient(model, scene, out, write, log, restart=False):
         with jsonl.open("a") as f:
             f.write(json.dumps(entry) + "\n")
 
-    bar = Progress(label="transient", every=5.0)
+    bar = Progress(label="transient", every=5.0, comm=model.comm)
 
     def progress(r):
         residual = r.residuals[-1] if r.residuals else 0.0

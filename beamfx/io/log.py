@@ -8,8 +8,8 @@ from mpi4py import MPI
 
 def log(msg, comm=MPI.COMM_WORLD, stream=None):
     """Print ``msg`` on rank 0 only, flushed (other ranks' output is block-buffered)."""
-    if comm.rank == 0:
-        print(msg, file=stream or sys.stdout, flush=True)
+    if comm.rank == 0:  # one write per line, so lines of concurrent ensemble members stay whole
+        print(f"{msg}\n", end="", file=stream or sys.stdout, flush=True)
 
 
 class Progress:

@@ -97,7 +97,7 @@ def _skip(plan, reason, log):
     return {"written": [], "skipped": {p["file"]: reason for p in plan}}
 
 
-def write_pictures(folder, results, log=print, animate=False, size=SIZE, timeout=900):
+def write_pictures(folder, results, log=print, animate=False, size=SIZE, timeout=900, comm=None):
     """Render the pictures of :func:`picture_plan` into ``folder`` (rank 0 only; the others
     return None). Never raises for a missing or failing renderer: the log says what was skipped.
 
@@ -108,7 +108,7 @@ def write_pictures(folder, results, log=print, animate=False, size=SIZE, timeout
 
     from mpi4py import MPI
 
-    if MPI.COMM_WORLD.rank != 0:
+    if (comm or MPI.COMM_WORLD).rank != 0:
         return None
     plan = picture_plan(results, animate)
     if not plan:

@@ -664,13 +664,23 @@ def _check_orientation(beam, where):
         )
 
 
-def load_scene(path):
-    """Read and validate a scene file; raises :class:`SceneError` naming file and key."""
-    path = Path(path)
+def read_toml(path):
+    """The TOML data of the file at ``path``; a missing or malformed file is a SceneError."""
     try:
-        data = tomllib.loads(path.read_text())
+        return tomllib.loads(Path(path).read_text())
     except FileNotFoundError:
         raise SceneError(f"{path}: no such scene file") from None
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{path}: not valid TOML: {e}") from None
+
+
+def load_scene(path):
+    """Read and validate a scene file; raises :class:`SceneError` naming file and key."""
+    path = Path(path)
+    data = read_toml(path)
+    if "sweep" in data:
+        raise SceneError(
+            f"{path}: sweep: this file describes a family of scenes (a parameter sweep); "
+            "run it with 'beamfx run', or read it with beamfx.scene.load_sweep"
+        )
     return parse_scene(data, str(path), path.parent)
