@@ -9,7 +9,7 @@ export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export PYTHONUNBUFFERED := 1
 
-.PHONY: install run test test-slow bench bench-peers lint clean
+.PHONY: install run test test-slow bench bench-peers bench-solid-scaling lint clean
 
 install:
 	bash scripts/install.sh
@@ -30,6 +30,12 @@ test-slow: install
 
 bench: install
 	$(VENV)/bin/beamfx bench --report docs/validation
+
+# the 231k-unknown solid on 1 and 2 ranks (about 2 min on a quiet 2-core machine)
+bench-solid-scaling: install
+	$(PY) -m beamfx.bench.solid_scaling run docs/validation
+	$(MPIRUN) $(PY) -m beamfx.bench.solid_scaling run docs/validation
+	$(PY) -m beamfx.bench.solid_scaling report docs/validation
 
 # beamfx beside Exudyn and PyElastica (own venv .venv-peers, not part of `make test`)
 PEERS := build/peers

@@ -150,3 +150,22 @@ def test_neo_hookean_small_load_matches_linear():
         tips[material] = solid.face_values("end")["displacement"][2]
     assert tips["svk"] == pytest.approx(tips["linear"], rel=1e-3)
     assert tips["neo-hookean"] == pytest.approx(tips["linear"], rel=1e-3)
+
+
+def test_scaling_projection_reproduces_its_measurements():
+    """The projection of the 231k solid to more ranks returns the 2-rank measurement at 2
+    ranks, halves a perfectly scaling part per doubling, and never undercuts perfect scaling."""
+    from beamfx.bench.solid_scaling import project
+
+    def run(ranks, assembly, setup, cg, its):
+        parts = {"assembly": assembly, "gamg_setup": setup, "cg": cg, "other": 0.0}
+        return {"ranks": ranks, "seconds_in_solve": parts, "krylov_iterations": its}
+
+    one, two = run(1, 3.0, 12.0, 36.0, 200), run(2, 1.5, 6.0, 24.0, 250)
+    low, high = project(one, two, 2)
+    assert low == pytest.approx(31.5) and high == pytest.approx(31.5)
+    perfect = run(2, 1.5, 6.0, 18.0, 200)
+    assert project(one, perfect, 8) == pytest.approx((25.5 / 4, 25.5 / 4))
+    for p in (4, 8, 16):
+        low, high = project(one, two, p)
+        assert 31.5 * 2 / p <= low < high

@@ -182,7 +182,9 @@ def markdown(results, figures=None, note=None):
         (
             "Elsewhere: beamfx beside Exudyn and PyElastica on the same problems, "
             "[peers.md](peers.md) (`make bench-peers`); the 3D solid against the beam, "
-            "[../solid.md](../solid.md); the Pai beam sweeps, [../pai_beam.md](../pai_beam.md)."
+            "[../solid.md](../solid.md), and at 231k unknowns on 1 and 2 ranks beside the beam, "
+            "[solid_scaling.md](solid_scaling.md) (`make bench-solid-scaling`); the Pai beam "
+            "sweeps, [../pai_beam.md](../pai_beam.md)."
         ),
         "",
     ]

@@ -7,7 +7,6 @@ converged, and reports both beside the elementary theory.
 """
 
 import json
-import resource
 import sys
 import time
 from pathlib import Path
@@ -71,23 +70,33 @@ def _static_levels(beam, E, nu, loads, material, levels, cell, pick, steps=1):
     return rows
 
 
-def sm21(levels=(2, 4, 6)):
-    """SM 2.1 cantilever, F_z, M_y, M_x together (linear)."""
-    beam = Beam("b", straight(1.0), sm.S21, 1, 3)
-    S = sections.rectangle(sm.E, sm.G, sm.RHO, 0.02, 0.01, nu=sm.NU)  # Saint-Venant torsion
-    spec = cantilever(straight(1.0), S, 2, 3, (0, 0, sm.F), (sm.MX, sm.MY, 0), kinematics=LINEAR)
-    tip, cost = _beam_tip(spec)
-    pick = lambda t: {
+def _pick21(t):
+    return {
         "u_z": t["displacement"][2],
         "phi_y": t["rotation_vector"][1],
         "phi_x": t["rotation_vector"][0],
     }
+
+
+def sm21_beam():
+    """The Timoshenko beam of SM 2.1 (Saint-Venant torsion constant): tip values and cost."""
+    S = sections.rectangle(sm.E, sm.G, sm.RHO, 0.02, 0.01, nu=sm.NU)
+    spec = cantilever(straight(1.0), S, 2, 3, (0, 0, sm.F), (sm.MX, sm.MY, 0), kinematics=LINEAR)
+    tip, cost = _beam_tip(spec)
+    return _pick21(tip), cost
+
+
+def sm21(levels=(2, 4, 6)):
+    """SM 2.1 cantilever, F_z, M_y, M_x together (linear)."""
+    beam = Beam("b", straight(1.0), sm.S21, 1, 3)
+    beam_values, cost = sm21_beam()
+    pick = _pick21
     rows = _static_levels(
         beam, sm.E, sm.NU, ((0, 0, sm.F), (sm.MX, sm.MY, 0)), "linear", levels, "hexahedron", pick
     )
     return {
         "theory": sm.THEORY_21,
-        "beam": pick(tip),
+        "beam": beam_values,
         "beam_cost": cost,
         "solid": rows,
         "note": "theory: Euler-Bernoulli with the paper's thin-strip S_t; beam: Timoshenko "
@@ -183,44 +192,7 @@ def sm28(levels=(2, 4, 6)):
     return {"theory": T, "beam": beam, "solid": rows}
 
 
-def large(cells=7, solver="iterative"):
-    """SM 2.1 cantilever with a fine hexahedral mesh (> 200k unknowns): CG + GAMG cost."""
-    from mpi4py import MPI
-
-    from ..solid.solve import Solid, SolidSpec
-
-    comm = MPI.COMM_WORLD
-    t0 = time.perf_counter()
-    spec = SolidSpec(
-        Beam("b", straight(1.0), sm.S21, 1),
-        sm.E,
-        sm.NU,
-        0.0,
-        ("start",),
-        {"end": ((0, 0, sm.F), (sm.MX, sm.MY, 0))},
-        "linear",
-        SolidMesh(cells, None, "hexahedron"),
-        solver=solver,
-    )
-    solid = Solid(spec, comm)
-    report = solid.solve_static()
-    tip = solid.face_values("end")
-    wall = time.perf_counter() - t0
-    rss = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, op=MPI.SUM) / 1024
-    return {
-        "ranks": comm.size,
-        "unknowns": solid.unknowns(),
-        **report,
-        "seconds": solid.seconds,
-        "wall_s": wall,
-        "max_rss_MiB_sum": rss,
-        "u_z": tip["displacement"][2],
-        "phi_x": tip["rotation_vector"][0],
-        "phi_y": tip["rotation_vector"][1],
-    }
-
-
-CASES = {"sm21": sm21, "sm22": sm22, "bend45": bend45, "sm28": sm28, "large": large}
+CASES = {"sm21": sm21, "sm22": sm22, "bend45": bend45, "sm28": sm28}
 
 
 def main(argv=None):
@@ -231,7 +203,7 @@ def main(argv=None):
         Path(argv.pop(argv.index("--report") + 1)) if "--report" in argv else Path("results/solid")
     )
     argv = [a for a in argv if a != "--report"]
-    names = argv or [k for k in CASES if k != "large"]
+    names = argv or list(CASES)
     out = {}
     for name in names:
         out[name] = CASES[name]()
@@ -239,7 +211,7 @@ def main(argv=None):
             print(json.dumps({name: out[name]}, indent=1, default=float), flush=True)
     if MPI.COMM_WORLD.rank == 0:
         report.mkdir(parents=True, exist_ok=True)
-        tag = "_".join(names) + (f"_np{MPI.COMM_WORLD.size}" if "large" in names else "")
+        tag = "_".join(names)
         (report / f"solid_{tag}.json").write_text(json.dumps(out, indent=1, default=float))
 
 

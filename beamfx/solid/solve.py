@@ -121,6 +121,8 @@ class Solid:
 
     def solve_static(self, steps=1, log=None):
         """Equilibrium at load factor 1 (one step if linear). Returns a dict of the solve."""
+        from petsc4py import PETSc
+
         from ..solvers import NewtonSolver, step_load
 
         v, du = ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
@@ -138,8 +140,6 @@ class Solid:
         solver = NewtonSolver(F, J, self.u, self.bcs, "beamfx_solid_", options)
         if self.iterative():
             basis = forms.rigid_body_modes(self.V)
-            from petsc4py import PETSc
-
             solver.A.setNearNullSpace(PETSc.NullSpace().create(vectors=basis))
         self.seconds["compile"] = time.perf_counter() - t0
         ksp_its = []
@@ -164,8 +164,10 @@ class Solid:
         n = 1 if self.spec.material == "linear" else steps
         history = step_load(solve_at, State(), steps=n, easy_iterations=6, log=log)
         self.seconds["solve"] = time.perf_counter() - t1
+        nonzeros = int(solver.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_used"])
         solver.destroy()
         return {
+            "matrix_nonzeros": nonzeros,
             "load_steps": len(history),
             "newton_iterations": int(sum(h.iterations for h in history)),
             "krylov_iterations": int(sum(ksp_its)),
