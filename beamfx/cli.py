@@ -45,6 +45,9 @@ def main(argv=None):
     p.add_argument("--layers", type=int, help="cells along the centre line (default: aspect 8)")
     p.add_argument("--cell", default="hexahedron", help="hexahedron (rectangles) or tetrahedron")
     p.add_argument("--solver", default="auto", choices=("auto", "direct", "iterative"))
+    p.add_argument(
+        "--png", action="store_true", help="also a picture of the solid and the beam (pyvista)"
+    )
     args = parser.parse_args(argv)
 
     from .scene import SceneError
@@ -77,7 +80,7 @@ def main(argv=None):
             from .solid.run import SolidMesh, run_solid
 
             mesh = SolidMesh(args.section_cells, args.layers, args.cell)
-            run_solid(args.scene, args.out, args.material, mesh, args.solver)
+            run_solid(args.scene, args.out, args.material, mesh, args.solver, png=args.png)
         elif args.command == "bench":
             from .bench import all_cases
             from .bench.run import run_bench

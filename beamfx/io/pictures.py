@@ -104,8 +104,6 @@ def write_pictures(folder, results, log=print, animate=False, size=SIZE, timeout
     Returns:
         ``{"written": [file names], "skipped": {file name: reason}}``.
     """
-    from importlib.util import find_spec
-
     from mpi4py import MPI
 
     if (comm or MPI.COMM_WORLD).rank != 0:
@@ -113,14 +111,26 @@ def write_pictures(folder, results, log=print, animate=False, size=SIZE, timeout
     plan = picture_plan(results, animate)
     if not plan:
         return {"written": [], "skipped": {}}
+    job = {"folder": os.fspath(folder), "plan": plan, "size": list(size)}
+    return render_in_child(CHILD, job, [item["file"] for item in plan], log, timeout)
+
+
+def render_in_child(child, job, files, log=print, timeout=900):
+    """Run the renderer ``child`` (Python code that imports pyvista before anything else) on
+    the JSON ``job`` in a separate process; its last output line is the JSON report
+    ``{"written": [...], "skipped": {file: reason}}``. Files it could not make (pyvista
+    missing, a crash, a timeout) are reported as skipped with the reason, never raised."""
+    from importlib.util import find_spec
+
+    folder = job["folder"]
+    plan = [{"file": f} for f in files]
     if find_spec("pyvista") is None:
         return _skip(plan, "pyvista is not installed (pip install pyvista)", log)
     env = dict(os.environ)
     env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    job = json.dumps({"folder": os.fspath(folder), "plan": plan, "size": list(size)})
     try:
         done = subprocess.run(
-            [sys.executable, "-c", CHILD, job],
+            [sys.executable, "-c", child, json.dumps(job)],
             capture_output=True,
             text=True,
             env=env,

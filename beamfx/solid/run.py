@@ -89,16 +89,20 @@ def build(spec, file="<scene>", comm=None):
         raise SceneError(f"{file}: beams[0]: {e}") from None
 
 
-def beam_values(scene, probes):
-    """The beam's probe values and cost (the scene's own model and mesh)."""
+def beam_values(scene, probes, vtu=None):
+    """The beam's probe values and cost (the scene's own model and mesh); with ``vtu``, its
+    deformed centre line is written there for ParaView and the picture."""
     from ..analyses.model import BeamModel
     from ..analyses.static import solve_static
+    from ..io import nodal_fields, write_vtu
     from ..io.probes import evaluate_points
 
     t0 = time.perf_counter()
     model = BeamModel(scene.model, extra_points=list(probes.values()))
     result = solve_static(model, steps=scene.steps, prefix="beamfx_solid_beam_")
     values = evaluate_points(model, list(probes.values()))
+    if vtu is not None:
+        write_vtu(vtu, nodal_fields(model))
     return {n: values[at] for n, at in probes.items()}, {
         "unknowns": model.unknowns(),
         "wall_s": time.perf_counter() - t0,
@@ -129,8 +133,11 @@ def markdown(rows):
     return "\n".join(lines)
 
 
-def run_solid(path, out=None, material=None, mesh=None, solver="auto", log=print):
-    """Solve the solid of the scene at ``path`` and compare it with the beam; return results."""
+def run_solid(path, out=None, material=None, mesh=None, solver="auto", log=print, png=False):
+    """Solve the solid of the scene at ``path`` and compare it with the beam; return results.
+
+    Writes ``solid.pvd`` (the solid's displacement), ``beam.vtu`` (the beam's deformed centre
+    line), ``results.json`` and ``results.md``; with ``png`` also ``solid_vs_beam.png``."""
     from mpi4py import MPI
 
     from ..io import write_json_atomic
@@ -160,7 +167,7 @@ def run_solid(path, out=None, material=None, mesh=None, solver="auto", log=print
     wall = time.perf_counter() - t0
     values = {n: solid.face_values(at.split(":")[-1]) for n, at in probes.items()}
     rss = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, op=MPI.SUM)
-    beam_vals, beam_cost = beam_values(scene, probes)
+    beam_vals, beam_cost = beam_values(scene, probes, out / "beam.vtu")
     rows = compare(beam_vals, values)
     results = {
         "scene": str(path),
@@ -180,6 +187,12 @@ def run_solid(path, out=None, material=None, mesh=None, solver="auto", log=print
     table = markdown(rows)
     if comm.rank == 0:
         (out / "results.md").write_text(f"# Solid vs beam: {path}\n\n{table}\n")
+    if png:
+        from .picture import write_solid_picture
+
+        title = f"{Path(path).name}: {spec.material}, {solid.unknowns()} unknowns"
+        results["pictures"] = write_solid_picture(out, title, say)
+        write_json_atomic(out / "results.json", results)
     say(table)
     say(
         f"solid {wall:.2f} s ({solid.unknowns()} unknowns, {report['krylov_iterations']} "
