@@ -160,3 +160,42 @@ def test_solid_matches_serial(solver):
     # few 1e-9 here (the thin solid's stiffness is ill-conditioned), CG stops at 1e-10 of the
     # residual with a partition-dependent preconditioner; a lost ghost update would be O(1).
     assert np.allclose(parallel, serial, rtol=1e-7, atol=1e-7 * np.abs(serial).max())
+
+
+def _docs_scene(analysis):
+    """The first complete scene of docs/scenes.md with ``[analysis] type = analysis``."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
+    for body in re.findall(r"^```toml\n(.*?)^```$", text, re.MULTILINE | re.DOTALL):
+        if re.search(rf'^type = "{analysis}"', body, re.MULTILINE) and "[[sweep]]" not in body:
+            return body
+    raise AssertionError(f"docs/scenes.md has no {analysis} scene")
+
+
+@pytest.mark.parametrize("analysis", ["arclength", "rotating", "buckling", "linear_static"])
+def test_documented_scene_runs_the_same_on_all_ranks(analysis):
+    """``beamfx run`` of the documented scene of each analysis from one process and from all
+    ranks: the same probes and, where the analysis has them, the same eigenvalues and path."""
+    import tomllib
+
+    from beamfx.runner import run_scene
+    from beamfx.scene import parse_scene
+
+    scene = parse_scene(tomllib.loads(_docs_scene(analysis)), f"{analysis}.toml")
+    folder = _shared_folder()
+    rank = MPI.COMM_WORLD.rank
+    serial = run_scene("s.toml", folder / f"serial{rank}", comm=MPI.COMM_SELF, scene=scene)
+    parallel = run_scene("s.toml", folder / "parallel", scene=scene)
+    for key in ("frequencies_hz", "load_factors"):
+        if key in serial:
+            assert np.allclose(parallel[key], serial[key], rtol=1e-8), key
+    if "path" in serial:
+        a = np.array([p["load_factor"] for p in parallel["path"]])
+        b = np.array([p["load_factor"] for p in serial["path"]])
+        assert a.shape == b.shape and np.allclose(a, b, rtol=1e-8, atol=1e-10)
+    for name, probe in serial["probes"].items():
+        for what in ("position", "rotation_vector"):
+            a, b = np.asarray(parallel["probes"][name][what]), np.asarray(probe[what])
+            assert np.allclose(a, b, rtol=1e-8, atol=1e-8 * max(1.0, np.abs(b).max())), (name, a, b)
