@@ -1,8 +1,8 @@
 """The 3D solid of a beam: its section swept along the centre line, meshed with gmsh.
 
 The section lies in the beam's reference section frame at the start (t0, e2, e3 of
-:func:`beamfx.physics.kinematics.section_frame`, with the default reference vector of
-:func:`beamfx.analyses.model.default_reference`): a rectangle has ``w`` along e2 and ``h``
+:func:`beamfx.physics.kinematics.section_frame`, with the beam's orientation vector or the
+default of :func:`beamfx.analyses.model.default_reference`, and its twist): a rectangle has ``w`` along e2 and ``h``
 along e3; a circle or tube is centred on the centre line. A :class:`~beamfx.geometry.Line` is
 swept by an extrusion and an :class:`~beamfx.geometry.Arc` by a revolution about the arc's
 axis, both with ``layers`` structured layers of cells (OpenCASCADE, exact geometry). With
@@ -58,8 +58,32 @@ def _unit(v):
     return v / np.linalg.norm(v)
 
 
-def start_frame(curve):
-    """Section frame at the start: e3 = global z made normal to t0 (global x if t0 ∥ z)."""
+def section_axes(t0, reference, twist_deg):
+    """(e2, e3) as the beam has them (:func:`beamfx.physics.kinematics.section_frame`):
+    ``reference`` made normal to t0 is e3, e2 = e3 × t0, both turned by ``twist_deg`` about t0."""
+    e3 = _unit(reference - (reference @ t0) * t0)
+    e2 = np.cross(e3, t0)
+    c, s = math.cos(math.radians(twist_deg)), math.sin(math.radians(twist_deg))
+    return c * e2 + s * e3, -s * e2 + c * e3
+
+
+def _reference(beam, t0):
+    """The beam's orientation vector, or the default one for the tangent t0."""
+    from ..analyses.model import default_reference
+
+    if beam.orientation is not None:
+        return np.asarray(beam.orientation, float)
+    return default_reference([t0])[0]
+
+
+def start_frame(beam):
+    """Section frame at the start of ``beam``, the beam's own (orientation, twist_deg)."""
+    t0 = _start_tangent(beam.curve)
+    e2, e3 = section_axes(t0, _reference(beam, t0), beam.twist_deg)
+    return Frame(np.asarray(beam.curve.start, float), t0, e2, e3)
+
+
+def _start_tangent(curve):
     from ..geometry import Arc, Line
 
     if isinstance(curve, Line):
@@ -72,27 +96,42 @@ def start_frame(curve):
         raise ValueError(  # noqa: TRY004 (a scene input, reported as SceneError)
             f"the solid sweeps lines and arcs only, not a {type(curve).__name__.lower()}"
         )
-    ref = np.array([1.0, 0, 0]) if abs(t0[2]) > 1 - 1e-8 else np.array([0, 0, 1.0])
-    e3 = _unit(ref - (ref @ t0) * t0)
-    return Frame(np.asarray(curve.start, float), t0, np.cross(e3, t0), e3)
+    return t0
 
 
-def end_frame(curve):
-    """The start frame carried to the end (translated along a line, turned with an arc)."""
+def carried_frame(beam, fraction=1.0):
+    """The start frame carried along ``fraction`` of the curve (translated along a line, turned
+    with an arc): the section of the swept solid there."""
     from ..geometry import Arc
 
-    f = start_frame(curve)
+    f, curve = start_frame(beam), beam.curve
     if not isinstance(curve, Arc):
-        return Frame(f.centre + curve.length * f.t0, f.t0, f.e2, f.e3)
-    axis = arc_axis(curve)
-    R = rotation_matrix(axis, math.radians(curve.angle_deg))
-    return Frame(curve.points([curve.length])[0], R @ f.t0, R @ f.e2, R @ f.e3)
+        return Frame(f.centre + fraction * curve.length * f.t0, f.t0, f.e2, f.e3)
+    R = rotation_matrix(arc_axis(curve), math.radians(fraction * curve.angle_deg))
+    return Frame(curve.points([fraction * curve.length])[0], R @ f.t0, R @ f.e2, R @ f.e3)
+
+
+def end_frame(beam):
+    """The section frame of the solid's end face."""
+    return carried_frame(beam)
+
+
+def frame_turn_deg(beam, samples=9):
+    """Largest angle (degrees) between the beam's section axes and the solid's (the start
+    section carried along the curve), at ``samples`` points; zero on a line, and on an arc
+    whose orientation vector lies along its axis or in its plane."""
+    turn = 0.0
+    for fraction in np.linspace(0.0, 1.0, samples):
+        f = carried_frame(beam, fraction)
+        _, e3 = section_axes(f.t0, _reference(beam, f.t0), beam.twist_deg)
+        turn = max(turn, math.degrees(math.acos(min(1.0, abs(e3 @ f.e3)))))
+    return turn
 
 
 def arc_axis(curve):
     """Unit axis a of an arc: turning the start about a (through the centre) follows it."""
     e_r = _unit(np.subtract(curve.start, curve.centre))
-    return _unit(np.cross(e_r, start_frame(curve).t0))
+    return _unit(np.cross(e_r, _start_tangent(curve)))
 
 
 def rotation_matrix(axis, angle):
@@ -126,8 +165,16 @@ def check_sweep(beam, options):
     from ..geometry import Arc
 
     kind, a2, a3, smallest = section_sizes(beam.section)
+    if isinstance(beam.curve, Arc) and kind == "rectangle" and frame_turn_deg(beam) > 1e-6:
+        raise SweepError(
+            "orientation",
+            f"the beam's section axes turn by up to {frame_turn_deg(beam):.3g}° against the arc "
+            "(its orientation vector is neither along the arc's axis nor in its plane); the "
+            "solid revolves the section rigidly: give an orientation along the axis "
+            f"{np.round(arc_axis(beam.curve), 6).tolist()} or in the arc's plane",
+        )
     if isinstance(beam.curve, Arc):
-        f = start_frame(beam.curve)
+        f = start_frame(beam)
         e_r = _unit(np.subtract(beam.curve.centre, beam.curve.start))
         half = 0.5 * (a2 * abs(e_r @ f.e2) + a3 * abs(e_r @ f.e3))  # rectangle's support
         if kind != "rectangle":
@@ -210,7 +257,7 @@ def _sweep(gmsh, beam, options, size, layers, is_arc):
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.option.setNumber("Mesh.MeshSizeMin", size)
     gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-    f = start_frame(beam.curve)
+    f = start_frame(beam)
     s = _section_surface(occ, beam.section)
     M = np.column_stack([f.e2, f.e3, f.t0, f.centre])
     occ.affineTransform([(2, s)], M.ravel().tolist())

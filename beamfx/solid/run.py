@@ -29,8 +29,6 @@ def spec_from_scene(scene, material=None, mesh=None, solver="auto"):
         raise SceneError(
             f"{file}: beams[0].section: the solid needs a prismatic rectangle, circle or tube"
         )
-    if beam.orientation is not None or beam.twist_deg:
-        raise SceneError(f"{file}: beams[0].orientation: the solid uses the default section axes")
     for what, items in (
         ("distributed loads", model.distributed_loads),
         ("springs", model.springs),
@@ -78,7 +76,11 @@ def _material(file):
 
 def build(spec, file="<scene>", comm=None):
     """The :class:`Solid`, with sweep errors named by scene key."""
-    keys = {"curve": "beams[0].curve", "section": "beams[0].section"}
+    keys = {
+        "curve": "beams[0].curve",
+        "section": "beams[0].section",
+        "orientation": "beams[0].orientation",
+    }
     try:
         return Solid(spec, comm)
     except SweepError as e:

@@ -77,7 +77,7 @@ class Solid:
         self.faces = {}
         for name, tag in FACES.items():
             A, c, I2 = forms.face_geometry(m, self.ds, tag)
-            frame = (start_frame if name == "start" else end_frame)(spec.beam.curve)
+            frame = (start_frame if name == "start" else end_frame)(spec.beam)
             self.faces[name] = {"tag": tag, "A": A, "c": c, "I2": I2, "frame": frame}
 
     def unknowns(self):
