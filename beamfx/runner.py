@@ -55,7 +55,6 @@ def run_scene(
     )
     from .io import log as default_log
     from .io.surface import SurfaceSeries, model_outlines, write_paraview_script
-    from .scene import load_scene
     from .solvers import SolveFailed
 
     comm = comm or MPI.COMM_WORLD
@@ -63,14 +62,13 @@ def run_scene(
     t_start = time.perf_counter()
     path = Path(path) if path else default_scene_path()
     if scene is None:
-        from .scene import load_sweep
+        from .scene import Sweep, load_scene_or_sweep
 
-        sweep = load_sweep(path)
-        if sweep is not None:
+        scene = load_scene_or_sweep(path)
+        if isinstance(scene, Sweep):
             from .sweep import run_sweep
 
-            return run_sweep(sweep, out_dir, log=log, png=png, comm=comm)
-        scene = load_scene(path)
+            return run_sweep(scene, out_dir, log=log, png=png, comm=comm)
     out = Path(out_dir or scene.output_dir)
     check_writable(out, comm)
     results_file = out / "results.json"
@@ -303,9 +301,9 @@ def check_scene(path):
     """Validate a scene without solving: keys, types, points, supports; for a sweep file every
     member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
     from .analyses.checks import check_supported
-    from .scene import load_scene, load_sweep
+    from .scene import Sweep, load_scene_or_sweep
 
-    sweep = load_sweep(path)
-    for scene in [m.scene for m in sweep.members] if sweep else [load_scene(path)]:
+    loaded = load_scene_or_sweep(path)
+    for scene in [m.scene for m in loaded.members] if isinstance(loaded, Sweep) else [loaded]:
         check_supported(scene.model)
-    return sweep or scene
+    return loaded

@@ -7,6 +7,7 @@ from importlib.util import find_spec
 import numpy as np
 import pytest
 from test_paraview import SHAKEN
+from test_solid import SCENE as SOLID_SCENE
 
 from beamfx.io import pictures
 from beamfx.runner import run_scene
@@ -144,38 +145,16 @@ def test_a_crashing_renderer_does_not_stop_the_run(tmp_path, monkeypatch):
     assert any("pictures skipped (deformed.png)" in m for m in messages)
 
 
-SOLID = """
-[material]
-E = 2.1e11
-nu = 0.3
-
-[[beams]]
-name = "b"
-curve = { shape = "line", start = [0, 0, 0], end = [1, 0, 0] }
-section = { type = "rectangle", h = 0.2, w = 0.1 }
-elements = 2
-degree = 3
-
-[[supports]]
-at = "b:start"
-fix = "all"
-
-[[loads]]
-at = "b:end"
-force = [0, 0, 1e8]
-
-[analysis]
-type = "linear_static"
-"""
-
-
 @needs_pyvista
 def test_picture_of_the_solid_and_the_beam(tmp_path):
     """``beamfx solid --png``: the solid coloured by |u| and the beam's centre line in red."""
     from beamfx.solid.picture import FILE
     from beamfx.solid.run import run_solid
 
-    (tmp_path / "scene.toml").write_text(SOLID)
+    line = '{ shape = "line", start = [0, 0, 0], end = [1, 0, 0] }'
+    section = '{ type = "rectangle", h = 0.2, w = 0.1 }'
+    scene = SOLID_SCENE.format(curve=line, section=section)
+    (tmp_path / "scene.toml").write_text(scene.replace("[0, 0, 1e4]", "[0, 0, 1e8]"))
     out = tmp_path / "out"
     results = run_solid(tmp_path / "scene.toml", out, log=lambda *a: None, png=True)
     assert results["pictures"]["written"] == [FILE]

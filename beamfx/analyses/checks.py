@@ -87,7 +87,13 @@ def section_axes_at(beam, s):
     h = 1e-6 * L
     a, b = max(s - h, 0.0), min(s + h, L)
     t = np.diff(beam.curve.points([a, b]), axis=0)[0]
-    t /= np.linalg.norm(t)
+    return frame_from_tangent(beam, t / np.linalg.norm(t))
+
+
+def frame_from_tangent(beam, t):
+    """Reference section frame Λ0 (columns: t, e2, e3) of ``beam`` where its unit tangent is
+    ``t``: the orientation vector (or the default one) made normal to t is e3, e2 = e3 × t,
+    both turned by ``twist_deg`` about t."""
     from .model import default_reference
 
     ref = default_reference(t[None])[0] if beam.orientation is None else beam.orientation

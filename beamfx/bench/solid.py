@@ -23,12 +23,15 @@ from ._builders import arc, cantilever, straight
 LINEAR = Kinematics(finite=False, shear=True)
 
 
-def _solid(beam, E, nu, rho, loads, material, cells, cell, clamped=("start",), **kw):
+def make_solid(beam, E, nu, rho, loads, material, cells, cell, clamped=("start",), **kw):
+    """(the Solid, its start time) of a case: ``cells`` across the section, keywords
+    ``layers`` and ``solver`` as in SolidMesh and SolidSpec."""
     from ..solid.solve import Solid, SolidSpec
 
     t0 = time.perf_counter()
+    mesh = SolidMesh(cells, kw.get("layers"), cell)
     spec = SolidSpec(
-        beam, E, nu, rho, clamped, loads, material, SolidMesh(cells, kw.get("layers"), cell)
+        beam, E, nu, rho, clamped, loads, material, mesh, solver=kw.get("solver", "auto")
     )
     solid = Solid(spec)
     return solid, t0
@@ -54,7 +57,7 @@ def _beam_tip(model_spec, steps=1):
 def _static_levels(beam, E, nu, loads, material, levels, cell, pick, steps=1):
     rows = []
     for n in levels:
-        solid, t0 = _solid(beam, E, nu, 0.0, {"end": loads}, material, n, cell)
+        solid, t0 = make_solid(beam, E, nu, 0.0, {"end": loads}, material, n, cell)
         report = solid.solve_static(steps=steps)
         tip = solid.face_values("end")
         rows.append(

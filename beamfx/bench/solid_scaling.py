@@ -15,7 +15,6 @@ import time
 from pathlib import Path
 
 from ..analyses.spec import Beam
-from ..solid.geometry import SolidMesh
 from . import schwab_meijaard_2009 as sm
 from ._builders import straight
 
@@ -27,23 +26,15 @@ def large(cells=CELLS, solver="iterative"):
     from mpi4py import MPI
     from petsc4py import PETSc
 
-    from ..solid.solve import Solid, SolidSpec
+    from .solid import make_solid
 
     comm = MPI.COMM_WORLD
     PETSc.Log.begin()
-    t0 = time.perf_counter()
-    spec = SolidSpec(
-        Beam("b", straight(1.0), sm.S21, 1),
-        sm.E,
-        sm.NU,
-        0.0,
-        ("start",),
-        {"end": ((0, 0, sm.F), (sm.MX, sm.MY, 0))},
-        "linear",
-        SolidMesh(cells, None, "hexahedron"),
-        solver=solver,
+    beam = Beam("b", straight(1.0), sm.S21, 1)
+    loads = {"end": ((0, 0, sm.F), (sm.MX, sm.MY, 0))}
+    solid, t0 = make_solid(
+        beam, sm.E, sm.NU, 0.0, loads, "linear", cells, "hexahedron", solver=solver
     )
-    solid = Solid(spec, comm)
     report = solid.solve_static()
     tip = solid.face_values("end")
     wall = time.perf_counter() - t0

@@ -1,7 +1,7 @@
 """TOML scene files ↔ model descriptions. Errors name the file, the key path and what is allowed."""
 
 from .load import Scene, SceneError, load_scene, parse_scene
-from .sweep import Member, Sweep, load_sweep, parse_sweep
+from .sweep import Member, Sweep, load_scene_or_sweep, load_sweep, parse_sweep
 
 __all__ = [
     "Member",
@@ -9,6 +9,7 @@ __all__ = [
     "SceneError",
     "Sweep",
     "load_scene",
+    "load_scene_or_sweep",
     "load_sweep",
     "parse_scene",
     "parse_sweep",

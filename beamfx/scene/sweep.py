@@ -127,8 +127,14 @@ def parse_sweep(data, file="<scene>", base=Path(".")):
 
 def load_sweep(path):
     """The :class:`Sweep` of the file at ``path``, or None if it has no ``[[sweep]]`` table."""
+    loaded = load_scene_or_sweep(path)
+    return loaded if isinstance(loaded, Sweep) else None
+
+
+def load_scene_or_sweep(path):
+    """The file at ``path`` read once: a :class:`Sweep` if it has ``[[sweep]]`` tables, else
+    its :class:`Scene`."""
     path = Path(path)
     data = read_toml(path)
-    if "sweep" not in data:
-        return None
-    return parse_sweep(data, str(path), path.parent)
+    parse = parse_sweep if "sweep" in data else parse_scene
+    return parse(data, str(path), path.parent)

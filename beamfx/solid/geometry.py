@@ -1,8 +1,8 @@
 """The 3D solid of a beam: its section swept along the centre line, meshed with gmsh.
 
 The section lies in the beam's reference section frame at the start (t0, e2, e3 of
-:func:`beamfx.physics.kinematics.section_frame`, with the beam's orientation vector or the
-default of :func:`beamfx.analyses.model.default_reference`, and its twist): a rectangle has ``w`` along e2 and ``h``
+:func:`beamfx.physics.kinematics.section_frame`, with the beam's orientation vector and twist,
+:func:`beamfx.analyses.checks.frame_from_tangent`): a rectangle has ``w`` along e2 and ``h``
 along e3; a circle or tube is centred on the centre line. A :class:`~beamfx.geometry.Line` is
 swept by an extrusion and an :class:`~beamfx.geometry.Arc` by a revolution about the arc's
 axis, both with ``layers`` structured layers of cells (OpenCASCADE, exact geometry). With
@@ -58,28 +58,11 @@ def _unit(v):
     return v / np.linalg.norm(v)
 
 
-def section_axes(t0, reference, twist_deg):
-    """(e2, e3) as the beam has them (:func:`beamfx.physics.kinematics.section_frame`):
-    ``reference`` made normal to t0 is e3, e2 = e3 × t0, both turned by ``twist_deg`` about t0."""
-    e3 = _unit(reference - (reference @ t0) * t0)
-    e2 = np.cross(e3, t0)
-    c, s = math.cos(math.radians(twist_deg)), math.sin(math.radians(twist_deg))
-    return c * e2 + s * e3, -s * e2 + c * e3
-
-
-def _reference(beam, t0):
-    """The beam's orientation vector, or the default one for the tangent t0."""
-    from ..analyses.model import default_reference
-
-    if beam.orientation is not None:
-        return np.asarray(beam.orientation, float)
-    return default_reference([t0])[0]
-
-
 def start_frame(beam):
     """Section frame at the start of ``beam``, the beam's own (orientation, twist_deg)."""
-    t0 = _start_tangent(beam.curve)
-    e2, e3 = section_axes(t0, _reference(beam, t0), beam.twist_deg)
+    from ..analyses.checks import frame_from_tangent
+
+    t0, e2, e3 = frame_from_tangent(beam, _start_tangent(beam.curve)).T
     return Frame(np.asarray(beam.curve.start, float), t0, e2, e3)
 
 
@@ -120,10 +103,12 @@ def frame_turn_deg(beam, samples=9):
     """Largest angle (degrees) between the beam's section axes and the solid's (the start
     section carried along the curve), at ``samples`` points; zero on a line, and on an arc
     whose orientation vector lies along its axis or in its plane."""
+    from ..analyses.checks import frame_from_tangent
+
     turn = 0.0
     for fraction in np.linspace(0.0, 1.0, samples):
         f = carried_frame(beam, fraction)
-        _, e3 = section_axes(f.t0, _reference(beam, f.t0), beam.twist_deg)
+        e3 = frame_from_tangent(beam, f.t0)[:, 2]
         turn = max(turn, math.degrees(math.acos(min(1.0, abs(e3 @ f.e3)))))
     return turn
 
@@ -165,10 +150,11 @@ def check_sweep(beam, options):
     from ..geometry import Arc
 
     kind, a2, a3, smallest = section_sizes(beam.section)
-    if isinstance(beam.curve, Arc) and kind == "rectangle" and frame_turn_deg(beam) > 1e-6:
+    turn = frame_turn_deg(beam) if isinstance(beam.curve, Arc) and kind == "rectangle" else 0.0
+    if turn > 1e-6:
         raise SweepError(
             "orientation",
-            f"the beam's section axes turn by up to {frame_turn_deg(beam):.3g}° against the arc "
+            f"the beam's section axes turn by up to {turn:.3g}° against the arc "
             "(its orientation vector is neither along the arc's axis nor in its plane); the "
             "solid revolves the section rigidly: give an orientation along the axis "
             f"{np.round(arc_axis(beam.curve), 6).tolist()} or in the arc's plane",
