@@ -1,0 +1,128 @@
+"""Typed settings whose fields are the scene keys: one declaration for the parser and the docs.
+
+A settings class is a frozen dataclass whose fields are declared with :func:`option`. The
+scene reader (:func:`beamfx.scene.schema.read_settings`) reads each field from its TOML table
+by the field's name, checks its type (from the annotation), range and choices, and rejects
+unknown keys; :func:`markdown_table` prints the same fields as the table of docs/scenes.md, so
+the schema and the docs cannot drift apart.
+
+Annotations understood: ``float``, ``int``, ``str``, ``bool``, ``Vec3`` (3 numbers),
+``tuple[float, ...]`` (a list of numbers), ``tuple[str, ...]`` (a list of strings), each
+optionally ``| None`` (the key may be left out; its default is then None).
+
+This module is pure Python (no NumPy, no DOLFINx), so every layer may import it.
+"""
+
+import dataclasses
+import types
+import typing
+
+Vec3 = tuple[float, float, float]
+
+_TYPE_WORDS = {
+    float: "number",
+    int: "integer",
+    str: "string",
+    bool: "true/false",
+    Vec3: "3 numbers",
+    tuple[float, ...]: "list of numbers",
+    tuple[str, ...]: "list of strings",
+}
+
+
+def option(default=dataclasses.MISSING, doc="", choices=None, positive=False, low=None, high=None):
+    """A settings field: its default, one line of documentation and its allowed values.
+
+    Args:
+        default: the value when the key is left out (``dataclasses.MISSING``: required).
+        doc: what the key means, with its unit (goes into the docs' table).
+        choices: the allowed values (strings or numbers).
+        positive: the value (each value of a list) must be > 0.
+        low, high: inclusive bounds of the value.
+    """
+    meta = {"doc": doc, "choices": choices, "positive": positive, "low": low, "high": high}
+    if isinstance(default, list | dict | set):
+        raise TypeError("use a tuple (immutable) as the default of a list-valued option")
+    return dataclasses.field(default=default, metadata=meta)
+
+
+class Spec(typing.NamedTuple):
+    """What the reader needs to know of one field."""
+
+    name: str
+    kind: object  # float, int, str, bool, Vec3, tuple[float, ...] or tuple[str, ...]
+    optional: bool  # None is allowed
+    default: object  # dataclasses.MISSING when required
+    doc: str
+    choices: tuple | None
+    positive: bool
+    low: float | None
+    high: float | None
+
+
+def specs(cls):
+    """The :class:`Spec` of every field of the settings class ``cls``, in declaration order."""
+    hints = typing.get_type_hints(cls)
+    out = []
+    for f in dataclasses.fields(cls):
+        kind, optional = hints[f.name], False
+        args = typing.get_args(kind)
+        if isinstance(kind, types.UnionType) or typing.get_origin(kind) is typing.Union:
+            rest = [a for a in args if a is not type(None)]
+            kind, optional = rest[0], len(rest) < len(args)
+        if kind not in _TYPE_WORDS:
+            raise TypeError(f"{cls.__name__}.{f.name}: unsupported settings type {kind!r}")
+        m = f.metadata
+        out.append(
+            Spec(
+                f.name,
+                kind,
+                optional,
+                f.default,
+                m.get("doc", ""),
+                tuple(m["choices"]) if m.get("choices") is not None else None,
+                m.get("positive", False),
+                m.get("low"),
+                m.get("high"),
+            )
+        )
+    return out
+
+
+def describe(spec):
+    """The allowed values of a field in words (for errors and docs)."""
+    word = _TYPE_WORDS[spec.kind]
+    if spec.choices is not None:
+        return "one of " + ", ".join(repr(c) for c in spec.choices)
+    parts = [word]
+    if spec.positive:
+        parts.append("> 0")
+    if spec.low is not None and spec.high is not None:
+        parts.append(f"in [{spec.low:g}, {spec.high:g}]")
+    elif spec.low is not None:
+        parts.append(f">= {spec.low:g}")
+    elif spec.high is not None:
+        parts.append(f"<= {spec.high:g}")
+    return " ".join(parts)
+
+
+def markdown_table(cls, defaults=None):
+    """The docs' table of a settings class: key, allowed values, default, meaning.
+
+    ``defaults`` overrides the printed default of fields whose default is computed (e.g.
+    ``{"output_every": "about 200 frames per run"}``).
+    """
+    defaults = defaults or {}
+    rows = ["| key | allowed | default | meaning |", "|---|---|---|---|"]
+    for s in specs(cls):
+        if s.name in defaults:
+            d = defaults[s.name]
+        elif s.default is dataclasses.MISSING:
+            d = "required"
+        else:
+            d = "none" if s.default is None else repr(s.default)
+        rows.append(f"| `{s.name}` | {describe(s)} | {d} | {s.doc} |")
+    return "\n".join(rows) + "\n"
+
+
+__all__ = ["Spec", "Vec3", "describe", "markdown_table", "option", "specs"]
