@@ -8,7 +8,8 @@ the schema and the docs cannot drift apart.
 
 Annotations understood: ``float``, ``int``, ``str``, ``bool``, ``Vec3`` (3 numbers),
 ``tuple[float, ...]`` (a list of numbers), ``tuple[str, ...]`` (a list of strings), each
-optionally ``| None`` (the key may be left out; its default is then None).
+optionally ``| None`` (the key may be left out; its default is then None); another settings
+class (a sub-table, e.g. ``[analysis.damping]``); ``object`` with a ``parse`` function.
 
 This module is pure Python (no NumPy, no DOLFINx), so every layer may import it.
 """
@@ -30,7 +31,16 @@ _TYPE_WORDS = {
 }
 
 
-def option(default=dataclasses.MISSING, doc="", choices=None, positive=False, low=None, high=None):
+def option(
+    default=dataclasses.MISSING,
+    doc="",
+    choices=None,
+    positive=False,
+    low=None,
+    high=None,
+    parse=None,
+    word=None,
+):
     """A settings field: its default, one line of documentation and its allowed values.
 
     Args:
@@ -39,8 +49,12 @@ def option(default=dataclasses.MISSING, doc="", choices=None, positive=False, lo
         choices: the allowed values (strings or numbers).
         positive: the value (each value of a list) must be > 0.
         low, high: inclusive bounds of the value.
+        parse: for a value no annotation describes (e.g. ``[component, value]``): a function
+            ``(value, fail) -> value`` that converts it or calls ``fail(message)``; the
+            annotation is then ``object`` and ``word`` says in words what is allowed.
     """
     meta = {"doc": doc, "choices": choices, "positive": positive, "low": low, "high": high}
+    meta.update(parse=parse, word=word)
     if isinstance(default, list | dict | set):
         raise TypeError("use a tuple (immutable) as the default of a list-valued option")
     return dataclasses.field(default=default, metadata=meta)
@@ -58,6 +72,13 @@ class Spec(typing.NamedTuple):
     positive: bool
     low: float | None
     high: float | None
+    parse: object = None  # (value, fail) -> value, for kind ``object``
+    word: str | None = None  # the allowed values in words, for kind ``object``
+
+
+def is_settings(kind):
+    """A nested settings class (a sub-table of the scene)?"""
+    return isinstance(kind, type) and dataclasses.is_dataclass(kind)
 
 
 def specs(cls):
@@ -70,7 +91,7 @@ def specs(cls):
         if isinstance(kind, types.UnionType) or typing.get_origin(kind) is typing.Union:
             rest = [a for a in args if a is not type(None)]
             kind, optional = rest[0], len(rest) < len(args)
-        if kind not in _TYPE_WORDS:
+        if kind not in _TYPE_WORDS and kind is not object and not is_settings(kind):
             raise TypeError(f"{cls.__name__}.{f.name}: unsupported settings type {kind!r}")
         m = f.metadata
         out.append(
@@ -84,6 +105,8 @@ def specs(cls):
                 m.get("positive", False),
                 m.get("low"),
                 m.get("high"),
+                m.get("parse"),
+                m.get("word"),
             )
         )
     return out
@@ -91,6 +114,10 @@ def specs(cls):
 
 def describe(spec):
     """The allowed values of a field in words (for errors and docs)."""
+    if spec.kind is object:
+        return spec.word or "see the docs"
+    if is_settings(spec.kind):
+        return "a table: " + ", ".join(f"`{s.name}`" for s in specs(spec.kind))
     word = _TYPE_WORDS[spec.kind]
     if spec.choices is not None:
         return "one of " + ", ".join(repr(c) for c in spec.choices)
@@ -125,4 +152,4 @@ def markdown_table(cls, defaults=None):
     return "\n".join(rows) + "\n"
 
 
-__all__ = ["Spec", "Vec3", "describe", "markdown_table", "option", "specs"]
+__all__ = ["Spec", "Vec3", "describe", "is_settings", "markdown_table", "option", "specs"]

@@ -23,25 +23,25 @@ def groups_of(size, members):
     return groups, [rank * groups // size for rank in range(size)]
 
 
-def summary(results):
-    """The numbers of one member's results that go into the sweep table (probes and, by
-    analysis, frequencies, buckling factors, limit points)."""
+def summary(run):
+    """The numbers of one member's run (:class:`~beamfx.runner.RunResult`) that go into the
+    sweep table: unknowns, iterations, probes, and what the analysis's ``summary()`` gives
+    (frequencies, buckling factors, limit points, why it stopped)."""
+    from .analyses.result import plain
+
     row = {
-        "unknowns": results["model"]["unknowns"],
-        "newton_iterations": results.get("newton_iterations"),
+        "unknowns": run.model["unknowns"],
+        "newton_iterations": run.result.newton_iterations,
         "probes": {
             name: {k: p[k] for k in ("displacement", "rotation_vector")}
-            for name, p in results["probes"].items()
+            for name, p in run.probes.items()
         },
     }
-    for key in ("frequencies_hz", "load_factors", "limit_points", "stopped_by"):
-        if key in results:
-            row[key] = results[key]
+    row.update(plain(run.result.summary()))
     return row
 
 
-def _solve_member(member, folder, comm, log, **options):
-    from .runner import run_scene
+def _solve_member(member, folder, comm, log, run_scene, **options):
     from .solvers import SolveFailed
 
     t0 = time.perf_counter()
@@ -50,7 +50,7 @@ def _solve_member(member, folder, comm, log, **options):
         results = run_scene(
             member.scene.file, folder, log=log, comm=comm, scene=member.scene, **options
         )
-        row.update(status="converged", **summary(results))
+        row.update(status=results.result.status, **summary(results))
     except SolveFailed as e:
         row.update(status="failed", reason=str(e))
     row["wall_s"] = time.perf_counter() - t0
@@ -58,12 +58,13 @@ def _solve_member(member, folder, comm, log, **options):
     return row
 
 
-def run_sweep(sweep, out_dir=None, log=None, comm=None, **options):
+def run_sweep(sweep, out_dir, run_scene, log=None, comm=None, **options):
     """Solve every member of ``sweep`` (:class:`beamfx.scene.Sweep`) on split communicators.
 
     Args:
         sweep: the parsed sweep.
-        out_dir: the sweep's folder (default: the scene's ``[output] dir``).
+        out_dir: the sweep's folder (None: the scene's ``[output] dir``).
+        run_scene: the function that runs one member (:func:`beamfx.runner.run_scene`).
         log: message sink (rank 0 of ``comm``); each group's messages are prefixed.
         comm: the ranks to share out (default: all).
         options: passed to :func:`beamfx.runner.run_scene` (``png``, ``animate``, ``restart``).
@@ -99,9 +100,8 @@ def run_sweep(sweep, out_dir=None, log=None, comm=None, **options):
         def member_log(msg, tag=tag):
             default_log(tag + msg, comm=group)
 
-        row = _solve_member(
-            member, out / f"member_{member.index:03d}", group, member_log, **options
-        )
+        folder = out / f"member_{member.index:03d}"
+        row = _solve_member(member, folder, group, member_log, run_scene, **options)
         rows.append(row)
         if group.rank == 0:
             with jsonl.open("a") as f:  # one short line, appended in a single write

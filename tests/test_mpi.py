@@ -113,7 +113,7 @@ def test_sweep_ensemble_matches_serial(values):
     data["model"] = {"condense": "none"}  # the quaternion model (the condensed one: above)
     sweep = parse_sweep(json.loads(json.dumps(data)), "sweep.toml")
     folder = _shared_folder()
-    table = run_sweep(sweep, folder / "ensemble")
+    table = run_sweep(sweep, folder / "ensemble", run_scene)
     assert table["groups"] == min(len(values), MPI.COMM_WORLD.size)
     for row, member in zip(table["members"], sweep.members):
         assert row["status"] == "converged"

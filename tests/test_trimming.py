@@ -125,7 +125,7 @@ def test_planar_transient_spin_up_agrees_with_the_full_model():
             sc = scene(text.replace("elements = 4", f"elements = {n}"), **{"model.plane": plane})
             assert sc.model.kinematics.plane == ("xy" if plane == "auto" else None)
             model = BeamModel(sc.model, extra_points=["beam:end"])
-            solve_transient(model, sc.settings["transient"])
+            solve_transient(model, sc.settings.solver())
             tips.append(np.array(evaluate_points(model, ["beam:end"])["beam:end"]["position"]))
         assert np.linalg.norm(tips[0] - [10, 0, 0]) > 1  # the hub has turned the beam
         differences.append(np.linalg.norm(tips[0] - tips[1]))

@@ -1,51 +1,89 @@
-"""A rotating analysis of a scene (``[analysis] type = "rotating"``, behind ``beamfx run``):
-steady state and rotating-frame frequencies at each speed, the Campbell diagram as
-``campbell.csv`` and ``campbell.png``, one ParaView step per speed (the steady state)."""
+"""A rotating analysis of a scene (``[analysis] type = "rotating"``): steady state and
+rotating-frame frequencies at each speed, the Campbell diagram as ``campbell.csv`` and
+``campbell.png``, one frame per speed (the steady state)."""
 
-from types import SimpleNamespace
+from dataclasses import dataclass
 
 import numpy as np
-from mpi4py import MPI
 
-from .campbell import campbell, write_campbell
-from .rotating import RotatingFrame
-from .spec import resolve_point
-
-
-def hub_point(scene):
-    """Coordinates of the scene's hub: the named point, else the first support's point."""
-    at = scene.settings.get("hub") or scene.model.supports[0].at
-    return at, resolve_point(scene.model, at)[2]
+from ..settings import Vec3, option
+from .registry import Analysis
+from .result import Result as _Base
+from .result import entry
 
 
-def run_rotating(model, scene, write, log, out):
-    """Solve the scene's rotating analysis and write the Campbell files into ``out``. Returns
-    (result with ``steps`` and ``seconds``, entries for ``results.json``)."""
-    settings = scene.settings
+@dataclass(frozen=True)
+class Settings:
+    """``[analysis]`` of a rotating analysis."""
+
+    axis: Vec3 = option((0.0, 0.0, 1.0), doc="spin axis (global axes, any length)")
+    hub: str | None = option(None, doc="named point on the spin axis (default: the first support)")
+    modes: int = option(6, positive=True, doc="modes per speed")
+    rotary_inertia: str = option("full", choices=("full", "none"), doc="rotary inertia")
+    speeds_rad_s: tuple[float, ...] | None = option(None, doc="spin speeds (rad/s), in order")
+    speed_rad_s: float | None = option(None, doc="one spin speed (rad/s) instead of a list")
+    steps: int = option(10, positive=True, doc="load steps of the first steady state")
+
+    def problems(self):
+        if not any(self.axis):
+            yield "axis", "must not be zero"
+        if self.hub is None:
+            yield "hub", "give the hub point (there is no support to default to)"
+        if (self.speeds_rad_s is None) == (self.speed_rad_s is None):
+            yield "speeds_rad_s", "give either speeds_rad_s = [...] or speed_rad_s = a number"
+
+    @staticmethod
+    def defaults(model):
+        """The hub defaults to the first support's point."""
+        return {"hub": model.supports[0].at} if model.supports else {}
+
+    def problems_in(self, model):
+        """The hub must be a point of the model."""
+        from .spec import resolve_point
+
+        try:
+            resolve_point(model, self.hub)
+        except ValueError as e:
+            yield "hub", str(e)
+
+    @property
+    def speeds(self):
+        """The speeds to solve (rad/s)."""
+        return self.speeds_rad_s if self.speeds_rad_s is not None else (self.speed_rad_s,)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Result(_Base):
+    """Steady states and frequencies per speed (the Campbell diagram)."""
+
+    axis: tuple = entry("unit spin axis")
+    hub: dict = entry("hub point name and position")
+    rotary_inertia: str = entry("rotary inertia used")
+    speeds_rad_s: tuple = entry("speeds solved (fewer than asked when stopped)")
+    frequencies_hz: tuple = entry("rotating-frame frequencies per speed")
+    stable: tuple = entry("whether each steady state is stable")
+    campbell: tuple = entry("branches followed across speeds (frequency, growth, MAC)")
+    stopped_by: str | None = entry("why the sweep of speeds ended early, or None")
+    files: dict = entry("campbell.csv and campbell.png")
+    steady_newton_iterations: tuple = entry("Newton iterations of each steady state")
+
+    def summary(self):
+        return {"frequencies_hz": list(self.frequencies_hz), "stopped_by": self.stopped_by}
+
+
+def _check_mass(model, ctx):
+    from mpi4py import MPI
+
     mass = model.comm.allreduce(float(np.max(model.inertia.x.array, initial=0.0)), op=MPI.MAX)
-    if mass <= 0 and not any(pm.mass for pm in getattr(scene.model, "point_masses", ())):
+    if mass <= 0 and not any(pm.mass for pm in ctx.spec.point_masses):
         raise ValueError(
-            f"{scene.file}: a rotating analysis needs mass: give [material] rho, or rho_A and "
+            f"{ctx.file}: a rotating analysis needs mass: give [material] rho, or rho_A and "
             "rho_I of the general sections"
         )
-    hub_at, hub = hub_point(scene)
-    frame = RotatingFrame(model, settings["axis"], hub, settings["rotary_inertia"])
-    log(
-        f"rotating about {frame.axis.round(6).tolist()} through {hub_at} "
-        f"{np.round(hub, 6).tolist()}, {len(settings['speeds_rad_s'])} speed(s)"
-    )
-    result = campbell(
-        frame,
-        settings["speeds_rad_s"],
-        settings["modes"],
-        steps=scene.steps,
-        options=scene.solver_options,
-        on_speed=lambda i, speed: write(i, float(speed)),  # ParaView: the steady state
-        log=log,
-    )
-    frame.destroy()
-    write_campbell(result, out, model.comm)
-    branches = [
+
+
+def _branches(result):
+    return tuple(
         {
             "branch": b + 1,
             "frequencies_hz": result.branches_hz[:, b].tolist(),
@@ -54,19 +92,54 @@ def run_rotating(model, scene, write, log, out):
             "out_of_plane": result.out_of_plane[:, b].tolist(),
         }
         for b in range(result.branches_hz.shape[1] if len(result.speeds) else 0)
-    ]
-    extra = {
-        "axis": frame.axis.tolist(),
-        "hub": {"at": hub_at, "position": np.asarray(hub).tolist()},
-        "rotary_inertia": settings["rotary_inertia"],
-        "speeds_rad_s": result.speeds.tolist(),
-        "frequencies_hz": result.frequencies_hz.tolist(),
-        "stable": result.stable.tolist(),
-        "campbell": branches,
-        "stopped_by": result.stopped_by,
-        "files": {"csv": "campbell.csv", "png": "campbell.png"},
-        "steady_newton_iterations": [s.newton_iterations for s in result.steady],
-    }
+    )
+
+
+def run(model, settings, ctx):
+    """Steady state and frequencies at every speed; the Campbell files in the output folder."""
+    from .campbell import campbell, write_campbell
+    from .rotating import RotatingFrame
+    from .spec import resolve_point
+
+    _check_mass(model, ctx)
+    hub = resolve_point(ctx.spec, settings.hub)[2]
+    frame = RotatingFrame(model, settings.axis, hub, settings.rotary_inertia)
+    ctx.log(
+        f"rotating about {frame.axis.round(6).tolist()} through {settings.hub} "
+        f"{np.round(hub, 6).tolist()}, {len(settings.speeds)} speed(s)"
+    )
+    result = campbell(
+        frame,
+        settings.speeds,
+        settings.modes,
+        steps=settings.steps,
+        options=ctx.solver_options,
+        on_speed=lambda i, speed: ctx.frames.write(i, float(speed)),  # the steady state
+        log=ctx.log,
+    )
+    frame.destroy()
+    write_campbell(result, ctx.folder, model.comm)
     steps = result.steady[-1].steps if result.steady else ()
-    seconds = {"total": float(sum(s.seconds["total"] for s in result.steady))}
-    return SimpleNamespace(steps=tuple(steps), seconds=seconds), extra
+    return Result(
+        analysis=ctx.analysis,
+        status="converged" if result.stopped_by is None else "stopped",
+        reason=result.stopped_by,
+        load_steps=tuple(steps),
+        newton_iterations=int(sum(s.iterations for s in steps)),
+        seconds={"total": float(sum(s.seconds["total"] for s in result.steady))},
+        axis=tuple(frame.axis.tolist()),
+        hub={"at": settings.hub, "position": np.asarray(hub).tolist()},
+        rotary_inertia=settings.rotary_inertia,
+        speeds_rad_s=tuple(result.speeds.tolist()),
+        frequencies_hz=tuple(result.frequencies_hz.tolist()),
+        stable=tuple(result.stable.tolist()),
+        campbell=_branches(result),
+        stopped_by=result.stopped_by,
+        files={"csv": "campbell.csv", "png": "campbell.png"},
+        steady_newton_iterations=tuple(s.newton_iterations for s in result.steady),
+    )
+
+
+ANALYSES = (
+    Analysis("rotating", Settings, run, plane=False, doc="steady states and Campbell diagram"),
+)

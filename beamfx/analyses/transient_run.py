@@ -1,16 +1,22 @@
-"""A transient analysis of a scene, written as it goes (behind ``beamfx run`` for
-``[analysis] type = "transient"``).
+"""A transient analysis of a scene (``[analysis] type = "transient"``), written as it goes.
 
 Every step appends a row to ``probes.csv`` and a line to ``probes.jsonl`` (time, step size,
 Newton iterations, the probes' position, displacement and unwrapped rotation, and the
-energy balance); every ``output_every`` steps adds a ParaView frame; every
+energy balance); frames every ``output_every`` steps (or as ``[output]`` says); every
 ``checkpoint_every`` steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
 import json
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..settings import option
+from .registry import Analysis
+from .result import Result as _Base
+from .result import entry
+
+SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
 ENERGY_KEYS = (
     "kinetic",
     "strain",
@@ -19,6 +25,77 @@ ENERGY_KEYS = (
     "dissipated_damping",
     "numerical",
 )
+
+
+@dataclass(frozen=True)
+class Damping:
+    """``[analysis.damping]``: Rayleigh damping."""
+
+    mass: float = option(0.0, low=0.0, doc="a0 (1/s): force a0 M q'")
+    stiffness: float = option(0.0, low=0.0, doc="a1 (s): viscous stress a1 C (strain rate)")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``[analysis]`` of a transient analysis."""
+
+    t_end: float = option(positive=True, doc="end time (s)")
+    dt: float = option(positive=True, doc="time step (s); cut back on failure, grown back")
+    scheme: str = option("generalized_alpha", choices=SCHEMES, doc="time integrator")
+    rho_inf: float = option(0.9, low=0.0, high=1.0, doc="generalized-α spectral radius")
+    hht_alpha: float = option(0.05, low=0.0, high=1 / 3, doc="HHT α")
+    dt_min: float | None = option(None, positive=True, doc="smallest step (default dt/1000)")
+    tolerance: float | None = option(
+        None, positive=True, doc="local error per step, relative (default: iteration control)"
+    )
+    damping: Damping = option(Damping(), doc="Rayleigh damping")
+    rotary_inertia: str = option("full", choices=("full", "polar", "none"), doc="rotary inertia")
+    output_every: int | None = option(
+        None, positive=True, doc="a frame every this many steps (default: about 200 per run)"
+    )
+    checkpoint_every: int = option(50, low=0, doc="steps between checkpoints (0: never)")
+    start: str = option("rest", choices=("rest", "static"), doc="from rest or a static state")
+    steps: int = option(10, positive=True, doc="load steps of a static start")
+
+    @property
+    def frames_every(self):
+        """Frames every this many steps, unless ``[output]`` says otherwise."""
+        return self.output_every or max(1, round(self.t_end / self.dt / 200))
+
+    def solver(self):
+        """The integrator's :class:`~beamfx.analyses.transient.TransientSettings`."""
+        from .transient import TransientSettings
+
+        return TransientSettings(
+            t_end=self.t_end,
+            dt=self.dt,
+            scheme=self.scheme,
+            rho_inf=self.rho_inf,
+            hht_alpha=self.hht_alpha,
+            dt_min=self.dt_min or self.dt / 1000,
+            tolerance=self.tolerance,
+            damping_mass=self.damping.mass,
+            damping_stiffness=self.damping.stiffness,
+            rotary_inertia=self.rotary_inertia,
+            output_every=self.frames_every,
+            checkpoint_every=self.checkpoint_every,
+        )
+
+
+@dataclass(frozen=True, kw_only=True)
+class Result(_Base):
+    """A time history (its rows are in probes.csv / probes.jsonl)."""
+
+    scheme: str = entry("the integrator")
+    t_end: float = entry("end time asked (s)")
+    time_steps: int = entry("accepted time steps")
+    restarted_from: float | None = entry("time of the checkpoint restarted from, or None")
+    energy: dict | None = entry("energy balance at the last step")
+    probe_history: dict = entry("the files of the probe history")
+    stopped_by: str = entry('"t_end" (a failed step raises, with its report)')
+
+    def summary(self):
+        return {"stopped_by": self.stopped_by, "time_steps": self.time_steps}
 
 
 def motion_warnings(model, t_end, samples=4000):
@@ -62,104 +139,146 @@ def _columns(probes):
     return cols + list(ENERGY_KEYS)
 
 
-def run_transient(model, scene, out, write, log, restart=False):
-    """Solve the scene's transient. Returns (result with ``steps``, results.json entries)."""
-    from ..io import Progress, evaluate_points, track_rotations
-    from .static import solve_static
-    from .transient import load_checkpoint, solve_transient
+class History:
+    """``probes.csv`` and ``probes.jsonl``: one row per accepted step, appended (rank 0).
 
-    comm = model.comm
-    settings = scene.settings["transient"]
-    for w in motion_warnings(scene.model, settings.t_end):
-        log(f"warning: {w}")
-    saved = load_checkpoint(out, comm) if restart else None
-    if restart and saved is None:
-        log("note: no checkpoint for this number of ranks; starting from t = 0")
-    if saved is None and scene.settings["start"] == "static":
-        model.set_time(0.0)
-        static = solve_static(model, steps=scene.steps, options=scene.solver_options, log=log)
-        log(f"static start: {static.newton_iterations} Newton iterations")
+    The files stay open for the run, so a step costs one buffered write each, whatever the
+    length of the run; they are flushed at every frame and at the end.
+    """
 
-    csv, jsonl = out / "probes.csv", out / "probes.jsonl"
-    probes = scene.probes
-    cols = _columns(probes)
-    t_restart = saved["t"] if saved else None
-    if saved is not None:
-        write.resume(t_restart)
-    if comm.rank == 0:
-        if saved is None:
-            csv.write_text(",".join(cols) + "\n")
-            jsonl.write_text("")
-        else:  # keep what was written up to the checkpoint
-            rows = csv.read_text().splitlines() if csv.exists() else [",".join(cols)]
-            keep = [r for r in rows[1:] if float(r.split(",")[1]) <= t_restart * (1 + 1e-12)]
-            csv.write_text("\n".join([rows[0], *keep]) + "\n")
-            lines = jsonl.read_text().splitlines() if jsonl.exists() else []
-            keep = [x for x in lines if json.loads(x)["time"] <= t_restart * (1 + 1e-12)]
-            jsonl.write_text("".join(x + "\n" for x in keep))
-    latest = {}
+    def __init__(self, folder, probes, comm, t_restart=None):
+        self.csv, self.jsonl = folder / "probes.csv", folder / "probes.jsonl"
+        self.probes, self.root = probes, comm.rank == 0
+        self.files = None
+        if not self.root:
+            return
+        header = ",".join(_columns(probes))
+        if t_restart is None:
+            self.csv.write_text(header + "\n")
+            self.jsonl.write_text("")
+        else:
+            self._truncate(header, t_restart * (1 + 1e-12))
+        self.files = (self.csv.open("a"), self.jsonl.open("a"))
 
-    def on_step(r):
-        values = evaluate_points(model, list(probes.values()))
-        latest["probes"] = track_rotations(latest.get("probes"), values)
-        latest["energy"] = r.energy
-        if r.step % settings.output_every == 0:
-            write(r.step, r.time)
-        if comm.rank != 0:
+    def _truncate(self, header, t_max):
+        """Keep what was written up to the checkpoint at ``t_max``."""
+        rows = self.csv.read_text().splitlines() if self.csv.exists() else [header]
+        keep = [r for r in rows[1:] if float(r.split(",")[1]) <= t_max]
+        self.csv.write_text("\n".join([rows[0], *keep]) + "\n")
+        lines = self.jsonl.read_text().splitlines() if self.jsonl.exists() else []
+        keep = [x for x in lines if json.loads(x)["time"] <= t_max]
+        self.jsonl.write_text("".join(x + "\n" for x in keep))
+
+    def add(self, r, values):
+        """The row of step record ``r`` with the tracked probe ``values``."""
+        if not self.root:
             return
         row = [r.step, r.time, r.dt, r.iterations, r.cutbacks]
         entry = {"step": r.step, "time": r.time, "dt": r.dt, "iterations": r.iterations}
         entry["probes"] = {}
-        for name, at in probes.items():
-            v = latest["probes"][at]
+        for name, at in self.probes.items():
+            v = values[at]
             row += [*v["position"], *v["displacement"], *v["rotation_vector_unwrapped"]]
-            entry["probes"][name] = {
-                k: v[k] for k in ("position", "displacement", "rotation_vector_unwrapped")
-            }
+            keys = ("position", "displacement", "rotation_vector_unwrapped")
+            entry["probes"][name] = {k: v[k] for k in keys}
         row += [r.energy[k] for k in ENERGY_KEYS]
         entry["energy"] = r.energy
-        with csv.open("a") as f:
-            f.write(",".join(f"{x:.12g}" for x in row) + "\n")
-        with jsonl.open("a") as f:
-            f.write(json.dumps(entry) + "\n")
+        self.files[0].write(",".join(f"{x:.12g}" for x in row) + "\n")
+        self.files[1].write(json.dumps(entry) + "\n")
 
-    bar = Progress(label="transient", every=5.0, comm=model.comm)
+    def flush(self):
+        for f in self.files or ():
+            f.flush()
+
+    def close(self):
+        for f in self.files or ():
+            f.close()
+        self.files = None
+
+
+def _start(model, settings, ctx):
+    """The checkpoint to go on from (restart), else a static start if asked; the checkpoint."""
+    from .static import solve_static
+    from .transient import load_checkpoint
+
+    saved = load_checkpoint(ctx.folder, ctx.comm) if ctx.restart else None
+    if ctx.restart and saved is None:
+        ctx.log("note: no checkpoint for this number of ranks; starting from t = 0")
+    if saved is None and settings.start == "static":
+        model.set_time(0.0)
+        opts = ctx.solver_options
+        static = solve_static(model, steps=settings.steps, options=opts, log=ctx.log)
+        ctx.log(f"static start: {static.newton_iterations} Newton iterations")
+    if saved is not None:
+        ctx.frames.resume(saved["t"])
+    return saved
+
+
+def _progress(comm, t_end):
+    from ..io import Progress
+
+    bar = Progress(label="transient", every=5.0, comm=comm)
 
     def progress(r):
         residual = r.residuals[-1] if r.residuals else 0.0
         bar.update(
             r.step,
-            f"t = {r.time:.5g}/{settings.t_end:g} s, dt = {r.dt:.3g}, {r.iterations} its, "
+            f"t = {r.time:.5g}/{t_end:g} s, dt = {r.dt:.3g}, {r.iterations} its, "
             f"|F| = {residual:.2e}",
         )
 
+    return bar, progress
+
+
+def run(model, settings, ctx):
+    """March to ``t_end`` (or on from the last checkpoint), writing the history as it goes."""
+    from .transient import solve_transient
+
+    for w in motion_warnings(ctx.spec, settings.t_end):
+        ctx.log(f"warning: {w}")
+    saved = _start(model, settings, ctx)
+    history = History(ctx.folder, ctx.probes, ctx.comm, saved["t"] if saved else None)
+    energy = {}
+
+    def on_step(r):
+        values = ctx.probe_values(model)
+        energy.update(r.energy)
+        history.add(r, values)
+        if ctx.frames.want(r.step, r.time):
+            history.flush()
+            ctx.frames.write(r.step, r.time)
+
+    bar, progress = _progress(model.comm, settings.t_end)
     try:
         result = solve_transient(
             model,
-            settings,
+            settings.solver(),
             on_step=on_step,
-            log=log,
+            log=ctx.log,
             progress=progress,
-            options=scene.solver_options,
-            checkpoint_dir=out,
+            options=ctx.solver_options,
+            checkpoint_dir=ctx.folder,
             saved=saved,
         )
     finally:
         bar.close()
-    if result.steps and result.steps[-1].step % settings.output_every:
-        write(result.steps[-1].step, result.steps[-1].time)
-    if "probes" not in latest:  # restarted at the end: nothing new
-        latest["probes"] = track_rotations(None, evaluate_points(model, list(probes.values())))
-    extra = {
-        "scheme": settings.parameters().name,
-        "t_end": settings.t_end,
-        "time_steps": len(result.steps),
-        "restarted_from": t_restart,
-        "energy": latest.get("energy"),
-        "probe_history": {"csv": csv.name, "jsonl": jsonl.name},
-        "stopped_by": result.stopped_by,
-    }
-    return result, extra, latest["probes"]
+        history.close()
+    if result.steps:
+        last = result.steps[-1]
+        if ctx.frames.want(last.step, last.time, last=True) and not ctx.frames.has(last.step):
+            ctx.frames.write(last.step, last.time)
+    return Result(
+        analysis=ctx.analysis,
+        newton_iterations=int(sum(s.iterations for s in result.steps)),
+        seconds=dict(result.seconds),
+        scheme=settings.solver().parameters().name,
+        t_end=settings.t_end,
+        time_steps=len(result.steps),
+        restarted_from=saved["t"] if saved else None,
+        energy=energy or None,
+        probe_history={"csv": history.csv.name, "jsonl": history.jsonl.name},
+        stopped_by=result.stopped_by,
+    )
 
 
-__all__ = ["motion_warnings", "run_transient"]
+ANALYSES = (Analysis("transient", Settings, run, doc="time history: dynamics"),)

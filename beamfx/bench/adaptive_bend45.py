@@ -44,6 +44,7 @@ class AdaptiveCase(Case):
     def run_setting(self, elements, degree, tolerance):
         from mpi4py import MPI
 
+        from ..analyses import static_run
         from ..analyses.adaptive import refine_to_tolerance, solve_once
         from ..analyses.condensed import condensed_fit
         from ..analyses.static import solve_static
@@ -55,7 +56,7 @@ class AdaptiveCase(Case):
         scene = Scene(
             "bench",
             spec,
-            steps=steps,
+            settings=static_run.Settings(steps=steps),
             probes={"tip": "b:end"},
             condense=condensed_fit(spec) is None,  # as the scene builder decides
             accuracy={

@@ -100,7 +100,9 @@ class TransientCase(Case):
             "wall_s_cold": cold,
             "wall_s_warm": warm,
             "jit_s": jit,
-            "warm_per_iteration_s": per_iteration(warm_result),
+            "warm_per_iteration_s": per_iteration(
+                warm_result.seconds, warm_result.newton_iterations
+            ),
             "values": {k: float(v) for k, v in self.measure(history, model).items()},
             "history": _thinned((self.series or tip_series)(history)),
         }

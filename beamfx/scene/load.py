@@ -33,7 +33,6 @@ from .table import SceneError, Table
 
 CURVE_SHAPES = ("line", "arc", "helix", "polyline", "spline", "gmsh")
 SECTION_TYPES = ("rectangle", "circle", "tube", "general")
-ANALYSES = ("static", "linear_static", "arclength", "modal", "buckling", "transient", "rotating")
 FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
 
 
@@ -44,14 +43,24 @@ class Scene:
     file: str
     model: Model
     analysis: str = "static"
-    steps: int = 10
     probes: dict = field(default_factory=dict)  # name -> point ("beam:end")
     output_dir: str = "results"
     solver_options: dict = field(default_factory=dict)
-    settings: dict = field(default_factory=dict)  # [analysis] keys of arclength, modal, buckling
+    settings: object = None  # the analysis's Settings (beamfx/analyses/<name>_run.py)
     trimming: object = None  # analyses.trimming.Trim: the model the builder chose, and why
     condense: bool = False  # the statically condensed model (analyses/condensed.py) is used
     accuracy: dict | None = None  # [accuracy]: tolerance on a probe quantity (adaptive.py)
+
+    def __post_init__(self):
+        if self.settings is None:  # a scene made in code: the analysis's defaults
+            from ..analyses.registry import analysis
+
+            object.__setattr__(self, "settings", analysis(self.analysis).settings())
+
+    @property
+    def steps(self):
+        """Load steps of the analysis's static solves (10 where it has none)."""
+        return getattr(self.settings, "steps", 10)
 
 
 def _curve(t, base):
@@ -291,6 +300,71 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     """Scene from already-parsed TOML data (``file`` is used in error messages)."""
     top = Table(data, "", file)
     mat = _material(top.table("material", None))
+    beams = _beams(top, mat, base, file)
+    supports = _supports(top)
+    point_loads, distributed, gravity = _loads(top)
+    springs = _springs(top)
+    masses = _masses(top)
+
+    mt = top.table("model", {})
+    plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
+    condense = mt.get("condense", str, "auto", choices=("auto", "none"))
+    kin = Kinematics(
+        finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
+        shear=mt.get("shear", bool, True),
+        stretch=mt.get("stretch", bool, True),
+        plane=plane if plane in PLANES else None,
+    )
+    mt.done()
+    at = top.table("analysis", {})
+    analysis, settings = _analysis(at, Model(tuple(beams), tuple(supports)))
+    if analysis.linear:
+        kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
+
+    probes = _probes(top)
+    ot = top.table("output", {})
+    out_dir = ot.get("dir", str, "results")
+    ot.done()
+    solver = top.get("solver", dict, {})
+    accuracy_table = top.table("accuracy", None)
+    top.done()
+
+    model = Model(
+        tuple(beams),
+        tuple(supports),
+        tuple(point_loads),
+        tuple(distributed),
+        tuple(springs),
+        gravity,
+        kin,
+        point_masses=tuple(masses),
+    )
+    _check_points(model, probes, file)
+    model, trimming = _trim(model, plane, analysis, settings)
+    if condense == "auto":
+        from ..analyses.condensed import condensed_fit
+
+        condense = condensed_fit(model, analysis.name) is None
+    else:
+        condense = False
+    accuracy = _accuracy(accuracy_table, probes, analysis.name)
+    _check_model(model, file)
+    return Scene(
+        file,
+        model,
+        analysis.name,
+        probes,
+        out_dir,
+        dict(solver),
+        settings,
+        trimming,
+        condense,
+        accuracy,
+    )
+
+
+def _beams(top, mat, base, file):
+    """``[[beams]]``: the beams, their names unique."""
     beams = []
     for t in top.tables("beams"):
         name = t.get("name", str)
@@ -314,7 +388,11 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         top.fail("beams", "a scene needs at least one [[beams]] table")
     for i, b in enumerate(beams):
         _check_orientation(b, f"{file}: beams[{i}].orientation")
+    return beams
 
+
+def _supports(top):
+    """``[[supports]]``: fixed dofs, prescribed motion."""
     supports = []
     for t in top.tables("supports"):
         sup = Support(
@@ -336,6 +414,11 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             t.fail("rotation", "a prescribed rotation needs rx, ry and rz in fix")
         supports.append(sup)
         t.done()
+    return supports
+
+
+def _loads(top):
+    """``[[loads]]``: point loads, distributed loads and gravity."""
     point_loads, distributed, gravity = [], [], (0.0, 0.0, 0.0)
     for t in top.tables("loads"):
         if t.has("gravity"):
@@ -368,6 +451,11 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         t.done(
             " (a point load has 'at'; a distributed one 'beam' or neither for all beams; or 'gravity')"
         )
+    return point_loads, distributed, gravity
+
+
+def _springs(top):
+    """``[[springs]]``: springs to ground."""
     springs = []
     for t in top.tables("springs"):
         sp = Spring(
@@ -379,35 +467,20 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             t.fail("stiffness", "give non-negative 'stiffness' and/or 'rotational', not all zero")
         springs.append(sp)
         t.done()
+    return springs
+
+
+def _masses(top):
+    """``[[masses]]``: rigid bodies attached at points."""
     masses = []
     for t in top.tables("masses"):
         masses.append(_point_mass(t))
         t.done()
+    return masses
 
-    mt = top.table("model", {})
-    plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
-    condense = mt.get("condense", str, "auto", choices=("auto", "none"))
-    kin = Kinematics(
-        finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
-        shear=mt.get("shear", bool, True),
-        stretch=mt.get("stretch", bool, True),
-        plane=plane if plane in PLANES else None,
-    )
-    mt.done()
-    at = top.table("analysis", {})
-    analysis = at.get("type", str, "static", choices=ANALYSES)
-    steps = at.get("steps", int, 10, positive=True)
-    settings = _continuation(at) if analysis == "arclength" else {}
-    if analysis in ("modal", "buckling"):
-        settings = _eigen(at, analysis)
-    if analysis == "transient":
-        settings = _transient(at)
-    if analysis == "rotating":
-        settings = _rotating(at, Model(tuple(beams), tuple(supports)))
-    at.done()
-    if analysis == "linear_static":
-        kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
 
+def _probes(top):
+    """``[[probes]]``: ``{name: point}``."""
     probes = {}
     for t in top.tables("probes"):
         name = t.get("name", str)
@@ -415,58 +488,37 @@ def parse_scene(data, file="<scene>", base=Path(".")):
             t.fail("name", f"probe {name!r} is given twice")
         probes[name] = t.get("at", str)
         t.done()
-    ot = top.table("output", {})
-    out_dir = ot.get("dir", str, "results")
-    ot.done()
-    solver = top.get("solver", dict, {})
-    accuracy_table = top.table("accuracy", None)
-    top.done()
+    return probes
 
-    model = Model(
-        tuple(beams),
-        tuple(supports),
-        tuple(point_loads),
-        tuple(distributed),
-        tuple(springs),
-        gravity,
-        kin,
-        point_masses=tuple(masses),
-    )
-    _check_points(model, probes, file)
-    model, trimming = _trim(model, plane, analysis, settings)
-    if condense == "auto":
-        from ..analyses.condensed import condensed_fit
 
-        condense = condensed_fit(model, analysis) is None
-    else:
-        condense = False
-    accuracy = _accuracy(accuracy_table, probes, analysis)
-    _check_model(model, file)
-    return Scene(
-        file,
-        model,
-        analysis,
-        steps,
-        probes,
-        out_dir,
-        dict(solver),
-        settings,
-        trimming,
-        condense,
-        accuracy,
-    )
+def _analysis(t, model):
+    """The :class:`~beamfx.analyses.registry.Analysis` of ``[analysis] type`` and its settings,
+    read from the rest of the table by the settings class's fields."""
+    from ..analyses.registry import analyses
+    from .schema import read_settings
+
+    entry = analyses()[t.get("type", str, "static", choices=tuple(analyses()))]
+    defaults = getattr(entry.settings, "defaults", lambda model: {})(model)
+    settings = read_settings(entry.settings, t, defaults)
+    for key, message in getattr(settings, "problems_in", lambda model: ())(model):
+        t.fail(key, message)
+    return entry, settings
 
 
 def _trim(model, plane, analysis, settings):
     """The model the scene needs: with ``[model] plane = "auto"`` (the default) the planar one
-    where the scene is a plane problem (:func:`~beamfx.analyses.trimming.choose_plane`)."""
-    from dataclasses import replace
+    where the scene is a plane problem (:func:`~beamfx.analyses.trimming.choose_plane`) and
+    the analysis allows it (``analysis.plane``)."""
+    from dataclasses import asdict, replace
 
     from ..analyses.trimming import Trim, choose_plane
 
     if plane != "auto":
         return model, Trim(model.kinematics.plane, False, f"stated: [model] plane = {plane!r}")
-    trim = choose_plane(model, analysis, settings)
+    if not analysis.plane:
+        why = f"full model: a {analysis.name} analysis has out-of-plane modes"
+        return model, Trim(None, True, why)
+    trim = choose_plane(model, analysis.name, asdict(settings))
     if trim.plane:
         model = replace(model, kinematics=replace(model.kinematics, plane=trim.plane))
     return model, trim
@@ -502,106 +554,6 @@ def _accuracy(t, probes, analysis):
         t.fail("max_degree", f"must be at least start_degree ({out['start_degree']})")
     t.done()
     return out
-
-
-def _continuation(t):
-    """Arc-length settings of ``[analysis]`` (type = "arclength")."""
-    out = {
-        "control_point": t.get("control_point", str, None),
-        "max_steps": t.get("max_steps", int, 200, positive=True),
-        "target_load_factor": t.get("target_load_factor", float, None),
-        "arc_length": t.get("arc_length", float, None, positive=True),
-        "method": t.get("method", str, "crisfield", choices=("crisfield", "riks")),
-    }
-    if t.has("displacement_limit"):
-        lim = t.get("displacement_limit", list)
-        if len(lim) != 2 or lim[0] not in DOF_NAMES[:3] or isinstance(lim[1], (str, bool)):
-            t.fail(
-                "displacement_limit",
-                f"write [component, value], component in {list(DOF_NAMES[:3])}",
-            )
-        out["displacement_limit"] = (lim[0], float(lim[1]))
-    if out["target_load_factor"] is None and "displacement_limit" not in out:
-        t.fail(
-            "type", "arclength needs target_load_factor or displacement_limit to know where to stop"
-        )
-    return out
-
-
-def _eigen(t, analysis):
-    """Settings of a modal or buckling ``[analysis]``."""
-    out = {"modes": t.get("modes", int, 6 if analysis == "modal" else 4, positive=True)}
-    if analysis == "modal":
-        out["target_hz"] = t.get("target_hz", float, 0.0)
-        out["rotary_inertia"] = t.get(
-            "rotary_inertia", str, "full", choices=("full", "polar", "none")
-        )
-        out["prestress"] = t.get("prestress", bool, True)
-    else:
-        out["about"] = t.get("about", str, "undeformed", choices=("undeformed", "current"))
-    return out
-
-
-def _rotating(t, model):
-    """Settings of a rotating ``[analysis]``: spin axis, hub point, speeds (rad/s), modes."""
-    from ..analyses.spec import resolve_point
-
-    out = {
-        "axis": t.get("axis", "vec3", (0.0, 0.0, 1.0)),
-        "hub": t.get("hub", str, model.supports[0].at if model.supports else None),
-        "modes": t.get("modes", int, 6, positive=True),
-        "rotary_inertia": t.get("rotary_inertia", str, "full", choices=("full", "none")),
-    }
-    if not any(out["axis"]):
-        t.fail("axis", "must not be zero")
-    if out["hub"] is None:
-        t.fail("hub", "give the hub point (there is no support to default to)")
-    try:
-        resolve_point(model, out["hub"])
-    except ValueError as e:
-        t.fail("hub", str(e))
-    if t.has("speeds_rad_s") == t.has("speed_rad_s"):
-        t.fail("speeds_rad_s", "give either speeds_rad_s = [...] or speed_rad_s = a number")
-    if t.has("speed_rad_s"):
-        out["speeds_rad_s"] = (t.get("speed_rad_s", float),)
-    else:
-        speeds = t.get("speeds_rad_s", list)
-        if not speeds or not all(isinstance(x, Real) and not isinstance(x, bool) for x in speeds):
-            t.fail("speeds_rad_s", f"expected a non-empty list of numbers, got {speeds!r}")
-        out["speeds_rad_s"] = tuple(float(x) for x in speeds)
-    return out
-
-
-def _transient(t):
-    """Settings of a transient ``[analysis]``: a TransientSettings and the start."""
-    from ..analyses.transient import SCHEMES, TransientSettings
-
-    t_end = t.get("t_end", float, positive=True)
-    dt = t.get("dt", float, positive=True)
-    damping = t.table("damping", {})
-    settings = TransientSettings(
-        t_end=t_end,
-        dt=dt,
-        scheme=t.get("scheme", str, "generalized_alpha", choices=SCHEMES),
-        rho_inf=t.get("rho_inf", float, 0.9),
-        hht_alpha=t.get("hht_alpha", float, 0.05),
-        dt_min=t.get("dt_min", float, dt / 1000, positive=True),
-        tolerance=t.get("tolerance", float, None, positive=True),
-        damping_mass=damping.get("mass", float, 0.0),
-        damping_stiffness=damping.get("stiffness", float, 0.0),
-        rotary_inertia=t.get("rotary_inertia", str, "full", choices=("full", "polar", "none")),
-        output_every=t.get("output_every", int, max(1, round(t_end / dt / 200)), positive=True),
-        checkpoint_every=t.get("checkpoint_every", int, 50),
-    )
-    damping.done()
-    if not 0.0 <= settings.rho_inf <= 1.0:
-        t.fail("rho_inf", f"must lie in [0, 1], got {settings.rho_inf}")
-    if not 0.0 <= settings.hht_alpha <= 1 / 3:
-        t.fail("hht_alpha", f"must lie in [0, 1/3], got {settings.hht_alpha}")
-    if min(settings.damping_mass, settings.damping_stiffness) < 0:
-        t.fail("damping", "mass and stiffness coefficients must be non-negative")
-    start = t.get("start", str, "rest", choices=("rest", "static"))
-    return {"transient": settings, "start": start}
 
 
 def _check_model(model, file):

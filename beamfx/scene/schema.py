@@ -9,7 +9,7 @@ import dataclasses
 import math
 import numbers
 
-from ..settings import Vec3, describe, specs
+from ..settings import Vec3, describe, is_settings, specs
 from .table import SceneError
 
 
@@ -21,6 +21,8 @@ def _convert(spec, value, fail):
     """``value`` as the field's type, or ``fail`` with the allowed values."""
     kind = spec.kind
     bad = f"expected {describe(spec)}, got {value!r}"
+    if kind is object:
+        return spec.parse(value, fail)
     if kind is bool:
         if not isinstance(value, bool):
             fail(bad)
@@ -52,7 +54,7 @@ def _check_range(spec, value, fail):
     for v in values:
         if spec.choices is not None and v not in spec.choices:
             fail(f"{v!r} is not allowed; allowed: {list(spec.choices)}")
-        if isinstance(v, str) or isinstance(v, bool):
+        if isinstance(v, (str, bool)):
             continue
         if (
             (spec.positive and v <= 0)
@@ -85,6 +87,10 @@ def read_settings(cls, table, defaults=None, done=True):
             raise SceneError(f"{where}: {message}")
 
         present = table is not None and table.has(spec.name)
+        if is_settings(spec.kind):  # a sub-table, all defaults when left out
+            sub = table.table(spec.name, {}) if table is not None else None
+            values[spec.name] = read_settings(spec.kind, sub)
+            continue
         if table is not None:
             table.used.add(spec.name)
         if not present:

@@ -1,0 +1,136 @@
+"""Arc-length continuation of a scene (``[analysis] type = "arclength"``): the equilibrium path
+through limit points, written to ``path.csv`` as it goes, its limit points in the results."""
+
+from dataclasses import dataclass
+
+from ..settings import option
+from .registry import Analysis
+from .result import Result as _Base
+from .result import entry
+from .spec import DOF_NAMES
+
+
+def _limit(value, fail):
+    """``[component, value]`` of ``displacement_limit``."""
+    ok = isinstance(value, list) and len(value) == 2 and value[0] in DOF_NAMES[:3]
+    if not ok or isinstance(value[1], (str, bool)) or not isinstance(value[1], (int, float)):
+        fail(f"write [component, value], component in {list(DOF_NAMES[:3])}; got {value!r}")
+    return (value[0], float(value[1]))
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``[analysis]`` of an arc-length continuation."""
+
+    control_point: str | None = option(
+        None, doc="named point whose displacement is traced (default: the first point load's)"
+    )
+    max_steps: int = option(200, positive=True, doc="accepted arc-length steps before stopping")
+    target_load_factor: float | None = option(None, doc="stop on reaching this load factor")
+    arc_length: float | None = option(
+        None, positive=True, doc="first arc length (default: from a first load increment 0.05)"
+    )
+    method: str = option("crisfield", choices=("crisfield", "riks"), doc="constraint")
+    displacement_limit: object = option(
+        None,
+        parse=_limit,
+        word="[component, value], component ux, uy or uz",
+        doc="stop when the control point's displacement component passes the value",
+    )
+
+    def points(self):
+        """Named points the model must have beyond the scene's probes."""
+        return () if self.control_point is None else (self.control_point,)
+
+    def problems_in(self, model):
+        """The control point must be a point of the model."""
+        from .spec import resolve_point
+
+        if self.control_point is not None:
+            try:
+                resolve_point(model, self.control_point)
+            except ValueError as e:
+                yield "control_point", str(e)
+
+    def problems(self):
+        if self.target_load_factor is None and self.displacement_limit is None:
+            yield "type", "arclength needs target_load_factor or displacement_limit to stop"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Result(_Base):
+    """The traced path and its limit points."""
+
+    control_point: str = entry("the traced point")
+    path: tuple = entry("load factor, displacement and arc length of every accepted point")
+    limit_points: tuple = entry("maxima and minima of the load factor along the path")
+    stopped_by: str = entry("target, stop (displacement limit) or max_steps")
+
+    def summary(self):
+        return {"limit_points": list(self.limit_points), "stopped_by": self.stopped_by}
+
+
+def _csv_writer(ctx):
+    """``record(index, point)``: one line of ``path.csv`` per accepted point (rank 0)."""
+    csv = ctx.folder / "path.csv"
+    root = ctx.comm.rank == 0
+    if root:
+        csv.write_text("step,load_factor,ux,uy,uz,arc_length,iterations\n")
+
+    def record(index, p):
+        if root:
+            u = ",".join(f"{x:.12g}" for x in p.displacement)
+            with csv.open("a") as f:
+                f.write(f"{index},{p.load_factor:.12g},{u},{p.arc_length:.12g},{p.iterations}\n")
+
+    return record
+
+
+def run(model, settings, ctx):
+    """Trace the path from the unloaded state; probes and a frame at every accepted point."""
+    from ..solvers.arclength import ArcLengthSettings
+    from .continuation import limit_points, trace_path
+
+    record, count = _csv_writer(ctx), [0]
+
+    def on_step(point):
+        record(count[0], point)
+        ctx.step(model, count[0], point.load_factor)
+        count[0] += 1
+
+    keys = ("control_point", "max_steps", "target_load_factor", "arc_length")
+    result = trace_path(
+        model,
+        **{k: getattr(settings, k) for k in keys},
+        displacement_limit=settings.displacement_limit,
+        settings=ArcLengthSettings(method=settings.method),
+        options=ctx.solver_options,
+        on_step=on_step,
+        log=ctx.log,
+    )
+    path = [
+        {"load_factor": p.load_factor, "displacement": p.displacement, "arc_length": p.arc_length}
+        for p in result.path
+    ]
+    limits = [
+        {"kind": p.kind, "load_factor": p.load_factor, "displacement": p.displacement}
+        for p in limit_points(result.path)
+    ]
+    for p in limits:
+        ctx.log(
+            f"  limit point ({p['kind']}): load factor {p['load_factor']:.6g} "
+            f"at {result.control_point}"
+        )
+    return Result(
+        analysis=ctx.analysis,
+        load_steps=tuple(result.steps),
+        newton_iterations=int(sum(s.iterations for s in result.steps)),
+        seconds=dict(result.seconds),
+        control_point=result.control_point,
+        path=tuple(path),
+        limit_points=tuple(limits),
+        stopped_by=result.reason,
+    )
+
+
+ANALYSES = (Analysis("arclength", Settings, run, doc="equilibrium path past limit points"),)

@@ -1,0 +1,69 @@
+"""What an analysis needs from the run besides its model and settings: where to write, what
+to report, how to solve. One :class:`RunContext` per ``beamfx run``."""
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+
+@dataclass
+class RunContext:
+    """The run side of an analysis: output folder, frames, probes, log and solver options.
+
+    Attributes:
+        analysis: the analysis type being run.
+        model: the model in use (replaced by :meth:`fallback`).
+        folder: the output folder (exists, writable).
+        comm: the communicator of the run.
+        log: message sink (rank 0 prints).
+        frames: the ParaView series: ``want(step, time, last)``, ``write(step, time)``,
+            ``resume(t_max)``, ``files()``.
+        probes: ``{probe name: point name}`` of the scene.
+        spec: the model description (:class:`~beamfx.analyses.spec.Model`).
+        file: the scene file, for messages.
+        solver_options: the scene's ``[solver]`` PETSc options.
+        restart: a transient goes on from its last checkpoint in ``folder``.
+        rebuild: ``rebuild() -> model``, the full (not condensed) model of the scene, for an
+            analysis that falls back to it; None where there is nothing to fall back to.
+    """
+
+    analysis: str
+    model: object
+    folder: Path
+    comm: object
+    log: Callable
+    frames: object
+    probes: dict
+    spec: object
+    file: str = "<scene>"
+    solver_options: dict = field(default_factory=dict)
+    restart: bool = False
+    rebuild: Callable | None = None
+    latest: dict | None = None  # probe values of the last accepted state, tracked
+
+    def probe_values(self, model, track=True):
+        """Probe values of the model's current state (collective): ``{point: values}``, the
+        rotations unwrapped along the path of earlier calls when ``track``."""
+        from ..io import evaluate_points, track_rotations
+
+        values = evaluate_points(model, list(dict.fromkeys(self.probes.values())))
+        self.latest = track_rotations(self.latest if track else None, values)
+        return self.latest
+
+    def step(self, model, step, time, last=False):
+        """After an accepted step: probes tracked, and a frame where the output asks."""
+        self.probe_values(model)
+        if self.frames.want(step, time, last):
+            self.frames.write(step, time)
+
+    def fallback(self):
+        """The full model instead of the condensed one: the failed attempt's probes and frames
+        are forgotten, and the new model is returned (and kept as :attr:`model`)."""
+        self.latest = None
+        self.frames.resume(0.0)
+        self.model, self.rebuild = self.rebuild(), None
+        self.frames.model = self.model
+        return self.model
+
+
+__all__ = ["RunContext"]

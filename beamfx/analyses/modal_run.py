@@ -1,0 +1,86 @@
+"""Modal analysis of a scene (``[analysis] type = "modal"``): natural frequencies about the
+unloaded state or, under loads, about the pre-stressed one; one frame per mode."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..settings import option
+from .registry import Analysis
+from .result import Result as _Base
+from .result import entry
+
+ROTARY = ("full", "polar", "none")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``[analysis]`` of a modal analysis."""
+
+    modes: int = option(6, positive=True, doc="number of modes")
+    target_hz: float = option(0.0, low=0.0, doc="the modes nearest this frequency (Hz)")
+    rotary_inertia: str = option("full", choices=ROTARY, doc="rotary inertia of the sections")
+    prestress: bool = option(True, doc="about the static state under the scene's loads")
+    steps: int = option(10, positive=True, doc="load steps of the pre-stressing solve")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Result(_Base):
+    """Frequencies and mode shapes."""
+
+    frequencies_hz: tuple = entry("natural frequencies (Hz), ascending")
+    effective_mass: tuple = entry("effective modal masses per mode and global direction")
+    omega_rad_s: tuple = entry("circular frequencies (rad/s)")
+    prestressed: bool = entry("solved about a loaded static state")
+    mode_shapes: tuple = entry("each mode's displacement at the probes (largest nodal = 1)")
+    paraview_steps: str = entry("what the ParaView frames hold")
+
+    def summary(self):
+        return {"frequencies_hz": list(self.frequencies_hz)}
+
+
+def _check_mass(model, ctx):
+    from mpi4py import MPI
+
+    mass = model.comm.allreduce(float(np.max(model.inertia.x.array, initial=0.0)), op=MPI.MAX)
+    if mass <= 0 and not ctx.spec.point_masses:
+        raise ValueError(
+            f"{ctx.file}: a modal analysis needs mass: give [material] rho, or rho_A and "
+            "rho_I of the general sections, or [[masses]]"
+        )
+
+
+def run(model, settings, ctx):
+    """Pre-stress (if loaded and asked), then the modes nearest ``target_hz``."""
+    from .modal import effective_masses, solve_modes
+    from .mode_shapes import PARAVIEW_STEPS, prestress, shapes
+
+    _check_mass(model, ctx)
+    spec, steps = ctx.spec, ()
+    if settings.prestress and (spec.point_loads or spec.distributed_loads or any(spec.gravity)):
+        steps = prestress(
+            model, settings.steps, ctx, "pre-stress: static solve under the scene's loads"
+        )
+        steps = steps.steps
+    target = (2 * np.pi * settings.target_hz) ** 2
+    res = solve_modes(
+        model, settings.modes, target, rotary=settings.rotary_inertia, options=ctx.solver_options
+    )
+    for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
+        ctx.log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s)")
+    m_eff = effective_masses(model, res.modes, settings.rotary_inertia)
+    return Result(
+        analysis=ctx.analysis,
+        load_steps=tuple(steps),
+        newton_iterations=int(sum(s.iterations for s in steps)),
+        seconds=dict(res.seconds),
+        frequencies_hz=tuple(res.hz.tolist()),
+        effective_mass=tuple(m_eff.tolist()),
+        omega_rad_s=tuple(res.omega.tolist()),
+        prestressed=bool(steps),
+        mode_shapes=shapes(model, res.modes, ctx),
+        paraview_steps=PARAVIEW_STEPS,
+    )
+
+
+ANALYSES = (Analysis("modal", Settings, run, plane=False, doc="natural frequencies and modes"),)

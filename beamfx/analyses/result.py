@@ -1,0 +1,85 @@
+"""What an analysis returns: a frozen dataclass with ``to_json()``, one shape for success and
+failure (``status`` and ``reason``), extended by each analysis with its own fields."""
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def plain(obj):
+    """``obj`` as JSON-ready lists, dicts and numbers (NumPy, NamedTuples, dataclasses)."""
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if hasattr(obj, "_asdict"):
+        return {k: plain(v) for k, v in obj._asdict().items()}
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, dict):
+        return {k: plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [plain(v) for v in obj]
+    return obj
+
+
+STATUSES = ("converged", "stopped", "failed")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Result:
+    """The part every analysis has.
+
+    Attributes:
+        analysis: the analysis type.
+        status: "converged" (done as asked), "stopped" (ended early by a physical stop the
+            scene allows, e.g. a lost steady state; ``reason`` says which) or "failed".
+        reason: why it stopped or failed (None when converged).
+        load_steps: the accepted load steps (:class:`~beamfx.solvers.stepping.LoadStep`) of
+            the last static solve, if any.
+        newton_iterations: Newton iterations of the analysis.
+        seconds: wall time split (compile, assemble_F, assemble_J, solve, total, ...).
+    """
+
+    analysis: str
+    status: str = "converged"
+    reason: str | None = None
+    load_steps: tuple = ()
+    newton_iterations: int = 0
+    seconds: dict = field(default_factory=dict)
+
+    def to_json(self):
+        """The analysis's entries of ``results.json`` (plain lists and numbers)."""
+        out = {"analysis": self.analysis, "converged": self.status == "converged"}
+        out["status"] = self.status
+        if self.reason is not None:
+            out["reason"] = self.reason
+        out["load_steps"] = [
+            {
+                "step": s.step,
+                "load_factor": s.load_factor,
+                "newton_iterations": s.iterations,
+                "residuals": list(s.residuals),
+                "cutbacks": s.cutbacks,
+            }
+            for s in self.load_steps
+        ]
+        out["newton_iterations"] = int(self.newton_iterations)
+        base = {f.name for f in dataclasses.fields(Result)}
+        for f in dataclasses.fields(self):
+            if f.name not in base and f.metadata.get("json", True):
+                out[f.name] = plain(getattr(self, f.name))
+        return out
+
+    def summary(self):
+        """The numbers of a sweep table (beyond probes and unknowns): by default none."""
+        return {}
+
+
+def entry(doc=""):
+    """A result field (documentation only; every field goes into ``results.json``)."""
+    return field(metadata={"doc": doc})
+
+
+__all__ = ["STATUSES", "Result", "entry", "plain"]

@@ -1,0 +1,72 @@
+"""Static analyses of a scene: ``static`` (nonlinear, adaptive load stepping to load factor 1)
+and ``linear_static`` (linear kinematics, one solve). A frame and the probes after every
+accepted load step."""
+
+from dataclasses import dataclass
+
+from ..settings import option
+from .registry import Analysis
+from .result import Result as _Base
+from .result import entry
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``[analysis]`` of a static analysis."""
+
+    steps: int = option(10, positive=True, doc="load steps to load factor 1 (halved on failure)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Result(_Base):
+    """A static solve; ``fallback`` says why the condensed model gave way to the full one."""
+
+    fallback: str | None = entry("why the statically condensed model was replaced, or None")
+    path: tuple = entry("load factor and the probes' values after every accepted load step")
+
+
+def solve(model, settings, ctx):
+    """Load stepping on ``model`` with the probes and frames of ``ctx`` after every step."""
+    from .static import solve_static
+
+    path = []
+
+    def on_step(step):
+        ctx.step(model, step.step, step.load_factor)
+        values = {name: ctx.latest[at] for name, at in ctx.probes.items()}
+        path.append({"load_factor": step.load_factor, "probes": values})
+
+    opts = ctx.solver_options
+    solved = solve_static(model, steps=settings.steps, options=opts, on_step=on_step, log=ctx.log)
+    return solved, tuple(path)
+
+
+def run(model, settings, ctx):
+    """Solve to load factor 1; a condensed model that fails is replaced by the full one."""
+    from ..solvers import SolveFailed
+    from .condensed import RotationRangeError
+
+    fallback = None
+    try:
+        solved, path = solve(model, settings, ctx)
+    except (RotationRangeError, SolveFailed) as e:
+        if ctx.rebuild is None:
+            raise
+        fallback = f"the statically condensed model failed ({e})"
+        ctx.log(f"model: {fallback}; solving the full model")
+        model = ctx.fallback()
+        solved, path = solve(model, settings, ctx)
+    return Result(
+        analysis=ctx.analysis,
+        load_steps=solved.steps,
+        newton_iterations=solved.newton_iterations,
+        seconds=dict(solved.seconds),
+        fallback=fallback,
+        path=path,
+    )
+
+
+ANALYSES = (
+    Analysis("static", Settings, run, doc="nonlinear static equilibrium at load factor 1"),
+    Analysis("linear_static", Settings, run, linear=True, doc="one linear solve"),
+)

@@ -1,0 +1,34 @@
+"""``beamfx run`` of one bench setting in a process of its own, timed from outside: the time a
+user waits for the command (interpreter start, imports, model, solve, output).
+
+    python -m beamfx.bench.process <case id> <elements> <degree> <output folder>
+
+The scene is built in code by the case (:func:`beamfx.bench.run.case_scene`) and then run by
+:func:`beamfx.runner.run_scene`, the call behind ``beamfx run``.
+"""
+
+import subprocess
+import sys
+import time
+
+
+def process_seconds(case_id, elements, degree, folder):
+    """Wall time of the child process that runs the setting (warm JIT cache)."""
+    cmd = [sys.executable, "-m", __name__, case_id, str(elements), str(degree), str(folder)]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True)
+    return time.perf_counter() - t0
+
+
+def main(argv):
+    case_id, elements, degree, folder = argv
+    from ..runner import run_scene
+    from . import all_cases
+    from .run import case_scene
+
+    scene = case_scene(all_cases()[case_id], int(elements), int(degree))
+    run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
