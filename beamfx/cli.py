@@ -4,7 +4,7 @@ import argparse
 import sys
 
 
-def main(argv=None):
+def _parser():
     parser = argparse.ArgumentParser(
         prog="beamfx", description="Geometrically exact 3D beams on FEniCSx."
     )
@@ -48,56 +48,77 @@ def main(argv=None):
     p.add_argument(
         "--png", action="store_true", help="also a picture of the solid and the beam (pyvista)"
     )
-    args = parser.parse_args(argv)
+    return parser
 
+
+def _run(args):
+    from .runner import run_scene
+
+    results = run_scene(
+        args.scene, args.out, restart=args.restart, png=args.png, animate=args.animate
+    )
+    failed = [m["member"] for m in results.get("members", []) if m["status"] != "converged"]
+    if failed:  # a sweep: the table is written, but say that it has holes
+        print(f"beamfx: sweep members {failed} failed (see sweep.md)", file=sys.stderr)
+        return 3
+    return 0
+
+
+def _check(args):
+    from .runner import check_scene
+
+    scene = check_scene(args.scene)
+    if hasattr(scene, "members"):
+        first = scene.members[0].scene
+        print(
+            f"{args.scene}: OK (a sweep of {len(scene.members)} scenes over "
+            f"{', '.join(scene.keys)}; analysis {first.analysis})"
+        )
+    else:
+        n = len(scene.model.beams)
+        print(f"{args.scene}: OK ({n} beam(s), analysis {scene.analysis})")
+    return 0
+
+
+def _solid(args):
+    from .solid.run import SolidMesh, run_solid
+
+    mesh = SolidMesh(args.section_cells, args.layers, args.cell)
+    run_solid(args.scene, args.out, args.material, mesh, args.solver, png=args.png)
+    return 0
+
+
+def _bench(args):
+    from .bench import all_cases
+    from .bench.run import run_bench
+    from .scene import SceneError
+
+    if args.list:
+        for cid, case in all_cases().items():
+            print(f"{cid:28s} {case.title}")
+        return 0
+    unknown = [c for c in args.cases if c not in all_cases()]
+    if unknown:
+        raise SceneError(f"unknown bench case(s) {unknown}; allowed: {list(all_cases())}")
+    results = run_bench(args.cases or None, args.report)
+    failed = [r["id"] for r in results if not r["passed"]]
+    print(
+        f"{len(results) - len(failed)}/{len(results)} cases within tolerance"
+        + (f"; outside: {failed}" if failed else "")
+    )
+    return 0
+
+
+COMMANDS = {"run": _run, "check": _check, "solid": _solid, "bench": _bench}
+
+
+def main(argv=None):
+    """``beamfx <command>``: 0 on success, 2 on bad input, 3 on a failed solve."""
+    args = _parser().parse_args(argv)
     from .scene import SceneError
 
     try:
-        if args.command == "run":
-            from .runner import run_scene
-
-            results = run_scene(
-                args.scene, args.out, restart=args.restart, png=args.png, animate=args.animate
-            )
-            failed = [m["member"] for m in results.get("members", []) if m["status"] != "converged"]
-            if failed:  # a sweep: the table is written, but say that it has holes
-                print(f"beamfx: sweep members {failed} failed (see sweep.md)", file=sys.stderr)
-                return 3
-        elif args.command == "check":
-            from .runner import check_scene
-
-            scene = check_scene(args.scene)
-            if hasattr(scene, "members"):
-                first = scene.members[0].scene
-                print(
-                    f"{args.scene}: OK (a sweep of {len(scene.members)} scenes over "
-                    f"{', '.join(scene.keys)}; analysis {first.analysis})"
-                )
-            else:
-                n = len(scene.model.beams)
-                print(f"{args.scene}: OK ({n} beam(s), analysis {scene.analysis})")
-        elif args.command == "solid":
-            from .solid.run import SolidMesh, run_solid
-
-            mesh = SolidMesh(args.section_cells, args.layers, args.cell)
-            run_solid(args.scene, args.out, args.material, mesh, args.solver, png=args.png)
-        elif args.command == "bench":
-            from .bench import all_cases
-            from .bench.run import run_bench
-
-            if args.list:
-                for cid, case in all_cases().items():
-                    print(f"{cid:28s} {case.title}")
-                return 0
-            unknown = [c for c in args.cases if c not in all_cases()]
-            if unknown:
-                raise SceneError(f"unknown bench case(s) {unknown}; allowed: {list(all_cases())}")
-            results = run_bench(args.cases or None, args.report)
-            failed = [r["id"] for r in results if not r["passed"]]
-            print(
-                f"{len(results) - len(failed)}/{len(results)} cases within tolerance"
-                + (f"; outside: {failed}" if failed else "")
-            )
+        return COMMANDS[args.command](args)
     except (SceneError, ValueError, OSError) as e:
         print(f"beamfx: error: {e}", file=sys.stderr)
         return 2
@@ -108,7 +129,6 @@ def main(argv=None):
             print(f"beamfx: solve failed: {e}", file=sys.stderr)
             return 3
         raise
-    return 0
 
 
 if __name__ == "__main__":
