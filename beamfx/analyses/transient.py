@@ -31,6 +31,7 @@ from ..physics.kinematics import displacement, strains
 from ..solvers import NewtonSolver
 from ..solvers.integrators import AlphaStep, generalized_alpha, hht, newmark
 from ..solvers.snes import SolveFailed
+from ..solvers.step_control import EasyGrowth, ErrorBased, StepControl, StepTooSmall
 from .checks import model_size
 from .conserving import Projection
 
@@ -441,10 +442,12 @@ def solve_transient(
         record = StepRecord(0, 0.0, 0.0, 0, (), 0, balance.record(None, 0.0))
         if on_step:
             on_step(record)
-    records, easy_run, iterations = [], 0, 0
+    records, iterations, error = [], 0, None
+    growth = ErrorBased() if s.tolerance else EasyGrowth(1.5, s.easy_iterations, 2, clean=True)
+    control = StepControl(h, s.dt, dt_min, growth)
     q_old = model.w.x.array.copy()
     while t < s.t_end * (1 - 1e-12):
-        h = min(h, s.t_end - t)
+        h = control.size = min(control.size, s.t_end - t)
         cutbacks, tried = 0, []
         while True:
             dyn.h.value = h
@@ -458,16 +461,18 @@ def solve_transient(
                 reason = f"local error {error:.3g} x tolerance"
                 tried.append((h, reason, report.residuals))
                 model.w.x.array[:] = dyn.q_n.x.array
-                h, cutbacks = max(h * max(0.2, 0.9 * error ** (-1 / 3)), dt_min), cutbacks + 1
+                h, cutbacks = control.rejected(error), cutbacks + 1
                 continue
             if report.converged:
                 break
             tried.append((h, report.reason, report.residuals))
             model.w.x.array[:] = dyn.q_n.x.array
-            h, cutbacks = h / 2, cutbacks + 1
-            if h < dt_min:
+            cutbacks += 1
+            try:
+                h = control.rejected()
+            except StepTooSmall:
                 if checkpoint_dir:
-                    save_checkpoint(checkpoint_dir, dyn, balance, t, h * 2, step)
+                    save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
                 lines = [
                     f"  dt = {dt:.3g}: {reason}, residuals {', '.join(f'{r:.3e}' for r in res)}"
                     for dt, reason, res in tried
@@ -475,7 +480,7 @@ def solve_transient(
                 raise TransientFailed(
                     f"time step from t = {t:.6g} failed at every step size down to "
                     f"dt_min = {dt_min:.3g}:\n" + "\n".join(lines)
-                )
+                ) from None
             log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
         q_old[:] = dyn.q_n.x.array
         balance.reactions()
@@ -495,12 +500,7 @@ def solve_transient(
             progress(record)
         if s.checkpoint_every and checkpoint_dir and step % s.checkpoint_every == 0:
             save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
-        if s.tolerance:  # the step that the error estimate asks for (safety factor 0.9)
-            h = min(s.dt, h * min(2.0, 0.9 * max(error, 1e-10) ** (-1 / 3)))
-        else:
-            easy_run = easy_run + 1 if report.iterations <= s.easy_iterations else 0
-            if cutbacks == 0 and easy_run >= 2:
-                h = min(s.dt, 1.5 * h)
+        h = control.accepted(report.iterations, cutbacks, error)
     if checkpoint_dir:
         save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
     seconds = {

@@ -364,12 +364,17 @@ class ArcLengthSolver:
         sign = math.copysign(1.0, first_load_increment)
         if target_load_factor is not None and target_load_factor != lam:
             sign = math.copysign(1.0, target_load_factor - lam)
-        dl0 = dl = float(arc_length)
+        from .step_control import IterationRatio, StepControl, StepTooSmall
+
+        dl0 = float(arc_length)
+        growth = IterationRatio(s.desired_iterations, 0.5, s.max_growth)
+        control = StepControl(dl0, s.max_arc_length * dl0, s.min_arc_length * dl0, growth)
         direction, steps, tried = sign, [], []
         saved = self.w.vector.copy()
         reason = "max_steps"
         while len(steps) < max_steps:
             self.w.vector.copy(saved)
+            dl = control.size
             try:
                 dw, dlam, its, res = self._step(lam, dl, direction)
             except _StepFailed as e:
@@ -379,8 +384,9 @@ class ArcLengthSolver:
                     log(
                         f"step {len(steps) + 1}: arc length {dl:.4g} failed ({e.args[0]}); halving it"
                     )
-                dl /= 2
-                if dl < s.min_arc_length * dl0:
+                try:
+                    control.rejected()
+                except StepTooSmall:
                     raise SolveFailed(self._failure(len(steps) + 1, lam, tried), steps) from None
                 continue
             reached = target_load_factor is not None and (
@@ -411,8 +417,7 @@ class ArcLengthSolver:
             if stop is not None and stop(step):
                 reason = "stop"
                 break
-            ratio = min(s.max_growth, max(0.5, math.sqrt(s.desired_iterations / max(its, 1))))
-            dl = min(dl * ratio, s.max_arc_length * dl0)
+            control.accepted(its)
         saved.destroy()
         self.lam.value = lam
         seconds = {**self.seconds, "total": time.perf_counter() - t_start}

@@ -57,10 +57,13 @@ def step_load(
     Raises:
         SolveFailed: naming the step, the load factor, its residual history and the cut-backs.
     """
+    from .step_control import EasyGrowth, StepControl, StepTooSmall
+
     nominal = 1.0 / steps
-    size, lam, history, tried = nominal, 0.0, [], []
+    control = StepControl(nominal, nominal, min_fraction, EasyGrowth(growth, easy_iterations))
+    lam, history, tried = 0.0, [], []
     while lam < 1.0 - 1e-14:
-        target = min(1.0, lam + size)
+        target = min(1.0, lam + control.size)
         state.save()
         if hasattr(state, "predict"):
             state.predict(lam, target)
@@ -78,8 +81,7 @@ def step_load(
             if on_step:
                 on_step(item)
             lam, tried = target, []
-            if report.iterations <= easy_iterations:
-                size = min(nominal, size * growth)
+            control.accepted(report.iterations)
             continue
         state.restore()
         tried.append((target, report.reason, report.residuals))
@@ -88,8 +90,9 @@ def step_load(
                 f"step {len(history) + 1}: no convergence at load factor {target:.6g} "
                 f"({report.reason}); cutting the step back"
             )
-        size /= 2
-        if size < min_fraction:
+        try:
+            control.rejected()
+        except StepTooSmall:
             lines = "\n".join(
                 f"  load factor {t:.6g}: {r}, |F| = " + ", ".join(f"{x:.3e}" for x in res)
                 for t, r, res in tried
@@ -98,5 +101,5 @@ def step_load(
                 f"Newton failed at step {len(history) + 1} after {len(tried)} attempts, the "
                 f"last converged load factor is {lam:.6g}; tried:\n{lines}",
                 history,
-            )
+            ) from None
     return history
