@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..geometry.frames import section_axes_at
 from .spec import DOF_NAMES, resolve_point
 
 
@@ -80,31 +81,6 @@ def connected_beams(model, rtol=1e-8):
     return sorted(groups.values())
 
 
-def section_axes_at(beam, s):
-    """Reference section frame Λ0 (columns: tangent, e2, e3) of ``beam`` at arc length s, in
-    NumPy, by the convention of :func:`beamfx.physics.kinematics.section_frame`."""
-    L = beam.curve.length
-    h = 1e-6 * L
-    a, b = max(s - h, 0.0), min(s + h, L)
-    t = np.diff(beam.curve.points([a, b]), axis=0)[0]
-    return frame_from_tangent(beam, t / np.linalg.norm(t))
-
-
-def frame_from_tangent(beam, t):
-    """Reference section frame Λ0 (columns: t, e2, e3) of ``beam`` where its unit tangent is
-    ``t``: the orientation vector (or the default one) made normal to t is e3, e2 = e3 × t,
-    both turned by ``twist_deg`` about t."""
-    from .model import default_reference
-
-    ref = default_reference(t[None])[0] if beam.orientation is None else beam.orientation
-    e3 = np.asarray(ref, float) - np.dot(ref, t) * t
-    e3 /= np.linalg.norm(e3)
-    e2 = np.cross(e3, t)
-    c, sn = np.cos(np.deg2rad(beam.twist_deg)), np.sin(np.deg2rad(beam.twist_deg))
-    e2, e3 = c * e2 + sn * e3, -sn * e2 + c * e3
-    return np.column_stack([t, e2, e3])
-
-
 #: dofs that the planar model does not have, per plane
 OUT_OF_PLANE = {"xy": ("uz", "rx", "ry"), "yz": ("ux", "ry", "rz"), "xz": ("uy", "rx", "rz")}
 
@@ -127,7 +103,8 @@ def _constraint_rows(model, beams, centre, size):
         frame = None
         if sup.axes == "local":
             b, s, _ = resolve_point(model, sup.at)
-            frame = section_axes_at(model.beams[b], s)
+            beam = model.beams[b]
+            frame = section_axes_at(beam.curve, s, beam.orientation, beam.twist_deg)
         add(sup.at, sup.fix, frame)
     for sp in model.springs:
         k = np.r_[sp.stiffness, sp.rotational]

@@ -9,6 +9,7 @@ import ufl
 from mpi4py import MPI
 
 from ..geometry import BeamSpec, build_mesh
+from ..geometry.frames import default_reference
 from ..physics import energy
 from ..physics.kinematics import (
     displacement,
@@ -21,15 +22,6 @@ from ..physics.kinematics import (
 from ..physics.rotations import np_quaternion
 from .checks import joint_breaks
 from .spec import DOF_NAMES, resolve_point
-
-
-def default_reference(tangents):
-    """Per tangent (rows): global z, or global x where the centre line runs along z.
-
-    The section frame makes it normal to the tangent (:func:`section_frame`).
-    """
-    along_z = np.abs(np.asarray(tangents)[:, 2]) > 1 - 1e-8
-    return np.where(along_z[:, None], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
 
 
 def _cell_field(mesh, degree, values):

@@ -8,7 +8,7 @@ unknowns per node. :func:`choose_plane` checks, for each coordinate plane xy, yz
 
 * every centre line lies in the plane (up to an offset), sampled along its length;
 * the plane's normal n is a principal axis of every section (n ∥ e2 or e3 of the reference
-  frame Λ0, :func:`~beamfx.analyses.checks.section_axes_at`, twist included), or the section
+  frame Λ0, :func:`~beamfx.geometry.frames.section_axes_at`, twist included), or the section
   is symmetric (EI_y = EI_z, GA_y = GA_z, equal rotary inertias): in-plane bending then uses
   one EI and does not couple to torsion or out-of-plane bending;
 * forces (point, distributed, gravity) lie in the plane and moments are normal to it;
@@ -29,8 +29,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..geometry.frames import section_axes_at
 from ..physics.kinematics import PLANES
-from .checks import free_rigid_modes, model_size, section_axes_at
+from .checks import free_rigid_modes, model_size
 from .spec import DOF_NAMES
 
 #: analyses whose answer includes out-of-plane motion of a plane structure
@@ -67,7 +68,8 @@ def _principal(model, n):
     """None if n is a principal axis of every section (or the section is symmetric)."""
     for b in model.beams:
         s = np.linspace(0.0, b.curve.length, 21)
-        normal = np.array([np.eye(3)[n] @ section_axes_at(b, si) for si in s])  # (t, e2, e3)
+        frames = [section_axes_at(b.curve, si, b.orientation, b.twist_deg) for si in s]
+        normal = np.array([np.eye(3)[n] @ f for f in frames])  # (t, e2, e3)
         aligned = np.minimum(np.abs(normal[:, 1]), np.abs(normal[:, 2])) < 1e-9
         if aligned.all():
             continue
@@ -98,7 +100,8 @@ def _supports(model, n):
         d, r = np.asarray(sup.displacement, float), np.asarray(sup.rotation, float)
         if sup.axes == "local":
             b, s, _ = resolve_point(model, sup.at)
-            frame = section_axes_at(model.beams[b], s)
+            beam = model.beams[b]
+            frame = section_axes_at(beam.curve, s, beam.orientation, beam.twist_deg)
             local_n = frame.T[:, n]
             if np.sort(np.abs(local_n))[-1] < 1 - 1e-9:
                 return f"supports[{i}] (local axes): the plane's normal is no section axis there"

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import ufl
 
+from ..geometry.frames import frame_from_tangent
 from ..physics.kinematics import d_ds
 from ..solvers.forms import compile_form
 from . import model as forms
@@ -23,7 +24,7 @@ KINDS = ("axial", "bending", "torsion", "section")
 class ContinuumSpec:
     """A straight beam from ``start`` to ``end`` with a rectangular section (``h`` along the
     section axis e3, ``w`` along e2, beamfx's convention; e3 is global z made normal to the
-    axis, as in :func:`beamfx.analyses.model.default_reference`).
+    axis, as in :func:`beamfx.geometry.frames.default_reference`).
 
     ``clamped``: clamp the start (r, d2, d3 fixed). ``force``, ``moment``: end load in global
     axes; ``follower``: the couple turns with the end section (else it acts in the reference
@@ -50,12 +51,9 @@ class ContinuumSpec:
 
 def reference_frame(start, end):
     """(t0, e2, e3) of a straight beam: e3 = global z made normal to t0 (x if t0 is along z),
-    e2 = e3 × t0 (as :func:`beamfx.physics.kinematics.section_frame`)."""
+    e2 = e3 × t0 (:func:`beamfx.geometry.frames.frame_from_tangent`, no twist)."""
     t0 = np.subtract(end, start) / np.linalg.norm(np.subtract(end, start))
-    ref = np.array([1.0, 0.0, 0.0]) if abs(t0[2]) > 1 - 1e-8 else np.array([0.0, 0.0, 1.0])
-    e3 = ref - (ref @ t0) * t0
-    e3 /= np.linalg.norm(e3)
-    return t0, np.cross(e3, t0), e3
+    return tuple(frame_from_tangent(t0).T)
 
 
 class ContinuumBeam:

@@ -2,7 +2,7 @@
 
 The section lies in the beam's reference section frame at the start (t0, e2, e3 of
 :func:`beamfx.physics.kinematics.section_frame`, with the beam's orientation vector and twist,
-:func:`beamfx.analyses.checks.frame_from_tangent`): a rectangle has ``w`` along e2 and ``h``
+:func:`beamfx.geometry.frames.frame_from_tangent`): a rectangle has ``w`` along e2 and ``h``
 along e3; a circle or tube is centred on the centre line. A :class:`~beamfx.geometry.Line` is
 swept by an extrusion and an :class:`~beamfx.geometry.Arc` by a revolution about the arc's
 axis, both with ``layers`` structured layers of cells (OpenCASCADE, exact geometry). With
@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+
+from ..geometry.frames import frame_from_tangent
 
 VOLUME, START, END = 1, 11, 12
 CELLS = ("tetrahedron", "hexahedron")
@@ -60,9 +62,7 @@ def _unit(v):
 
 def start_frame(beam):
     """Section frame at the start of ``beam``, the beam's own (orientation, twist_deg)."""
-    from ..analyses.checks import frame_from_tangent
-
-    t0, e2, e3 = frame_from_tangent(beam, _start_tangent(beam.curve)).T
+    t0, e2, e3 = frame_from_tangent(_start_tangent(beam.curve), beam.orientation, beam.twist_deg).T
     return Frame(np.asarray(beam.curve.start, float), t0, e2, e3)
 
 
@@ -103,12 +103,10 @@ def frame_turn_deg(beam, samples=9):
     """Largest angle (degrees) between the beam's section axes and the solid's (the start
     section carried along the curve), at ``samples`` points; zero on a line, and on an arc
     whose orientation vector lies along its axis or in its plane."""
-    from ..analyses.checks import frame_from_tangent
-
     turn = 0.0
     for fraction in np.linspace(0.0, 1.0, samples):
         f = carried_frame(beam, fraction)
-        e3 = frame_from_tangent(beam, f.t0)[:, 2]
+        e3 = frame_from_tangent(f.t0, beam.orientation, beam.twist_deg)[:, 2]
         turn = max(turn, math.degrees(math.acos(min(1.0, abs(e3 @ f.e3)))))
     return turn
 
