@@ -34,6 +34,7 @@ from ..physics import energy
 from ..physics.kinematics import strains
 from ..solvers.eigen import solve_eigen
 from ..solvers.forms import compile_form
+from .dofs import constrained_dofs, subspace_dofs
 from .modal import to_functions
 
 
@@ -101,13 +102,6 @@ def path_tangent(model, J_form, F_form):
     for obj in (ksp, A, f, dg):
         obj.destroy()
     return dw
-
-
-def constrained_dofs(bcs):
-    """Local indices (ghosts included) of the dofs constrained by ``bcs``."""
-    if not bcs:
-        return np.empty(0, np.int32)
-    return np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
 
 
 def penalty_tangent(model):
@@ -194,7 +188,7 @@ def _scaled_max(model, f):
     size = model.comm.allreduce(np.ptp(x, axis=0).max() if len(x) else 0.0, op=MPI.MAX)
     local = 0.0
     for sub, scale in ((0, 1.0 / max(size, 1e-300)), (1, 1.0)):
-        dofs = model.W.sub(sub).collapse()[1]
+        dofs = subspace_dofs(model.W, sub)
         if len(dofs):
             local = max(local, scale * np.abs(f.x.array[dofs]).max())
     return model.comm.allreduce(local, op=MPI.MAX)

@@ -3,6 +3,7 @@
 import numpy as np
 
 from ..geometry.frames import section_axes_at
+from .dofs import OUT_OF_PLANE
 from .spec import DOF_NAMES, resolve_point
 
 
@@ -79,10 +80,6 @@ def connected_beams(model, rtol=1e-8):
     for i in range(len(model.beams)):
         groups.setdefault(root(i), []).append(i)
     return sorted(groups.values())
-
-
-#: dofs that the planar model does not have, per plane
-OUT_OF_PLANE = {"xy": ("uz", "rx", "ry"), "yz": ("ux", "ry", "rz"), "xz": ("uy", "rx", "rz")}
 
 
 def _constraint_rows(model, beams, centre, size):

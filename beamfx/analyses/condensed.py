@@ -29,6 +29,7 @@ from mpi4py import MPI
 from ..physics import condensed as rod
 from ..physics.kinematics import Kinematics
 from ..physics.rotations import np_exp_rotation
+from .dofs import constrained_dofs, owned_size
 from .spec import DOF_NAMES, resolve_point
 
 #: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
@@ -91,8 +92,8 @@ class FollowerCoupling:
         self.model, self.forces = model, forces  # [(Constant F, f0, point, G forms)]
         self.G = [[fem.petsc.create_vector(G_i) for G_i in f[3]] for f in forces]
         V = model.V
-        self._bc_dofs = np.concatenate([bc.dof_indices()[0] for bc in model.bcs])
-        owned = V.dofmap.index_map.size_local * 3
+        self._bc_dofs = constrained_dofs(model.bcs)
+        owned = owned_size(V)
         self._rows = np.arange(owned, dtype=np.int32)
         self._rows_global = V.dofmap.index_map.local_range[0] * 3 + self._rows
         self._tip = [self._point_dofs(f[2]) for f in forces]

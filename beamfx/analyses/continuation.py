@@ -14,6 +14,7 @@ from mpi4py import MPI
 
 from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
+from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
 from .spec import DOF_NAMES
 
 
@@ -45,39 +46,6 @@ class ContinuationResult(NamedTuple):
     @property
     def displacements(self):
         return np.array([p.displacement for p in self.path]).reshape(-1, 3)
-
-
-def point_displacement_dofs(model, at):
-    """Owned local dofs of u_x, u_y, u_z at the named point ``at`` (empty where not owned)."""
-    from dolfinx import fem
-
-    if at not in model.mesh.points:
-        raise ValueError(
-            f"{at!r} is not a named point of the model; named points are "
-            f"{sorted(model.mesh.points)} (supports, loads and springs)"
-        )
-    verts = model.mesh.point_tags.find(model.mesh.points[at][0])
-    owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
-    components = {name: comp for name, sub, comp in model.kin.dofs() if sub == 0}
-    out = []
-    for name in DOF_NAMES[:3]:
-        if name not in components:  # out of the planar model's plane: always zero
-            out.append(np.empty(0, np.int32))
-            continue
-        d = fem.locate_dofs_topological(model.W.sub(0).sub(components[name]), 0, verts)
-        out.append(d[d < owned][:1])
-    return out
-
-
-def point_displacement(model, dofs, values=None):
-    """u at a point from :func:`point_displacement_dofs` (collective), of ``model.w`` or of
-    another array of the same space (``values``)."""
-    values = model.w.x.array if values is None else values
-    local = np.array([values[d].sum() for d in dofs])
-    count = np.array([len(d) for d in dofs], float)
-    total = model.comm.allreduce(local, op=MPI.SUM)
-    n = model.comm.allreduce(count, op=MPI.SUM)
-    return total / np.maximum(n, 1)
 
 
 def _check_model(model):
@@ -158,7 +126,7 @@ def trace_path(
     base = settings or ArcLengthSettings()
     settings = replace(base, follower=base.follower or follower)
     c0 = compile_seconds[0]
-    _, u_dofs = model.W.sub(0).collapse()
+    u_dofs = subspace_dofs(model.W, 0)
     solver = ArcLengthSolver(
         model.F,
         model.J,
@@ -168,7 +136,7 @@ def trace_path(
         prefix,
         options,
         settings,
-        norm_dofs=np.asarray(u_dofs),
+        norm_dofs=u_dofs,
     )
     compile_time = compile_seconds[0] - c0
 

@@ -141,20 +141,21 @@ def effective_masses(model, modes, rotary="full"):
     """
     import dolfinx.fem.petsc as fp
 
-    from ..analyses.spec import DOF_NAMES
+    from .dofs import displacement_components, owned_size, subspace_dofs
+    from .spec import DOF_NAMES
 
     M = fp.assemble_matrix(compile_form(mass_ufl(model, rotary)), bcs=model.bcs, diagonal=0.0)
     M.assemble()
     r, Mr, Mphi = M.createVecRight(), M.createVecLeft(), M.createVecLeft()
-    owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
-    sub_of = {name: comp for name, sub, comp in model.kin.dofs() if sub == 0}
+    owned = owned_size(model.W)
+    sub_of = displacement_components(model.kin)
     out = np.zeros((len(modes), 3))
     for d, name in enumerate(DOF_NAMES[:3]):
         if name not in sub_of:  # out of the planar model's plane
             continue
-        dofs = model.W.sub(0).sub(sub_of[name]).collapse()[1]
+        dofs = subspace_dofs(model.W, 0, sub_of[name])
         r.set(0.0)
-        r.array[[i for i in dofs if i < owned]] = 1.0
+        r.array[dofs[dofs < owned]] = 1.0
         M.mult(r, Mr)
         for k, mode in enumerate(modes):
             M.mult(mode.vector, Mphi)

@@ -4,14 +4,14 @@ the probes, and written as one ParaView frame per mode."""
 import numpy as np
 from mpi4py import MPI
 
-from .continuation import point_displacement, point_displacement_dofs
+from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
 
 PARAVIEW_STEPS = "one per mode (time = mode number), displacement scaled to 1/10 of the model size"
 
 
 def normalise(model, modes):
     """Scale each mode (in place) so that its largest nodal displacement is 1."""
-    _, u_dofs = model.W.sub(0).collapse()
+    u_dofs = subspace_dofs(model.W, 0)
     for mode in modes:
         local = np.max(np.abs(mode.x.array[u_dofs]), initial=0.0)
         peak = model.comm.allreduce(local, op=MPI.MAX)

@@ -21,6 +21,7 @@ from ..physics.kinematics import (
 )
 from ..physics.rotations import np_quaternion
 from .checks import joint_breaks
+from .dofs import subspace_dofs
 from .spec import DOF_NAMES, resolve_point
 
 
@@ -108,7 +109,7 @@ class BeamModel:
         self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q]))
         self.w = fem.Function(self.W, name="unknowns")
         quaternion = self.kin.finite and not self.kin.plane
-        self._q0_dofs = self.W.sub(1).sub(0).collapse()[1] if quaternion else []
+        self._q0_dofs = subspace_dofs(self.W, 1, 0) if quaternion else []
         self.reset()
 
         # measures: shear/axial with p Gauss points (exact to 2p-1), the rest with p+1

@@ -28,6 +28,7 @@ from ..physics.kinematics import displacement, spatial_virtual_rotation
 from ..physics.rotating import centrifugal_potential, gyroscopic_covector, relative_position
 from ..solvers.forms import compile_form
 from ..solvers.quadratic import solve_quadratic
+from .dofs import owned_size, subspace_dofs
 from .modal import mass_ufl
 from .static import StaticResult, load_scale, solve_static
 
@@ -278,11 +279,11 @@ def mac_matrix(M, first, second):
 def axis_fraction(model, vector, axis):
     """Share of a mode's displacement amplitude along ``axis``: Σ|u·e|² / Σ|u|² over the
     displacement nodes (1: out of the rotation plane, 0: in it). Collective."""
-    n_owned = model.W.dofmap.index_map.size_local * model.W.dofmap.index_map_bs
+    n_owned = owned_size(model.W)
     comps = []
     for i in range(model.kin.displacement_size):
-        dofs = model.W.sub(0).sub(i).collapse()[1]
-        comps.append(vector[np.asarray(dofs)[np.asarray(dofs) < n_owned]])
+        dofs = subspace_dofs(model.W, 0, i)
+        comps.append(vector[dofs[dofs < n_owned]])
     if model.kin.plane:
         from ..physics.kinematics import PLANES
 

@@ -34,6 +34,7 @@ from ..solvers.snes import SolveFailed
 from ..solvers.step_control import EasyGrowth, ErrorBased, StepControl, StepTooSmall
 from .checks import model_size
 from .conserving import Projection
+from .dofs import constrained_dofs, owned_size, subspace_dofs
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
 
@@ -105,7 +106,7 @@ class Dynamics:
         V_u, u_dofs = W.sub(0).collapse()
         self.u_dofs = np.asarray(u_dofs).reshape(-1, kin.displacement_size)
         self.u_points = V_u.tabulate_dof_coordinates()
-        self.r_dofs = np.asarray(W.sub(1).collapse()[1]).reshape(-1, kin.rotation_size)
+        self.r_dofs = subspace_dofs(W, 1).reshape(-1, kin.rotation_size)
         self._is_displacement = np.zeros(len(self.q_n.x.array), bool)
         self._is_displacement[self.u_dofs.ravel()] = True
         self._quaternion = kin.finite and not kin.plane
@@ -239,7 +240,7 @@ class Dynamics:
         _, _, qdd = self.scheme.advance(q, *arrays, h)
         e = h**2 * abs(self.scheme.p.beta - 1 / 6) * (qdd - self.qdd_n.x.array)
         scale = tolerance * (np.abs(q) + np.where(self._is_displacement, length, 1.0))
-        n = self.model.W.dofmap.index_map.size_local * self.model.W.dofmap.index_map_bs
+        n = owned_size(self.model.W)
         comm = self.model.comm
         total = comm.allreduce(float(np.sum((e[:n] / scale[:n]) ** 2)))
         return np.sqrt(total / comm.allreduce(n))
@@ -269,7 +270,6 @@ class EnergyBalance:
         import dolfinx.fem.petsc as fp
 
         from ..solvers.forms import compile_form
-        from .buckling import constrained_dofs
 
         self.dyn, m = dyn, dyn.model
         self.T = compile_form(dyn.kinetic)
@@ -282,7 +282,7 @@ class EnergyBalance:
         self.vec = fp.create_vector(self.residual)
         self.mask = np.zeros(len(m.w.x.array), bool)  # constrained, owned dofs
         self.mask[constrained_dofs(m.bcs)] = True
-        self.n_owned = m.W.dofmap.index_map.size_local * m.W.dofmap.index_map_bs
+        self.n_owned = owned_size(m.W)
         self.mask[self.n_owned :] = False
         self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
         self.previous = self.initial = None

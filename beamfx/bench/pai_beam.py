@@ -140,7 +140,7 @@ def settle(model, steps=1):
 def _march(model, settings, saved=None, coordinate=None):
     """Run :func:`solve_transient` and record the tip displacement relative to the clamp,
     and ``coordinate(unknowns)`` (a number computed from the unknowns' array) if given."""
-    from ..analyses.continuation import point_displacement, point_displacement_dofs
+    from ..analyses.dofs import point_displacement, point_displacement_dofs
     from ..analyses.transient import solve_transient
 
     tip_dofs = point_displacement_dofs(model, "b:end")
@@ -230,7 +230,7 @@ def linear_modes(model, n_modes=4):
     The planar model's lowest modes are bending modes (axial and shear ones are kHz)."""
     import dolfinx.fem.petsc as fp
 
-    from ..analyses.continuation import point_displacement, point_displacement_dofs
+    from ..analyses.dofs import point_displacement, point_displacement_dofs
     from ..analyses.modal import mass_ufl, solve_modes
     from ..solvers.forms import compile_form
 

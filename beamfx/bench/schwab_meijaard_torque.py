@@ -78,6 +78,7 @@ def dense_pencil(model):
     from dolfinx import fem
 
     from ..analyses import buckling as bk
+    from ..analyses.dofs import constrained_dofs
     from ..solvers.forms import compile_form
 
     if model.comm.size > 1:
@@ -92,7 +93,7 @@ def dense_pencil(model):
     K = fp.assemble_matrix(J_form, bcs=model.bcs, diagonal=1.0)
     K.assemble()
     Kg = bk.stress_stiffness(model, J_form, S_form)
-    free = np.setdiff1d(np.arange(K.getSize()[0]), bk.constrained_dofs(model.bcs))
+    free = np.setdiff1d(np.arange(K.getSize()[0]), constrained_dofs(model.bcs))
     mu = scipy.linalg.eigvals(_dense(K, free), -_dense(Kg, free))
     K.destroy()
     Kg.destroy()
@@ -105,7 +106,7 @@ def dense_modes(model, rotary="polar"):
     dense: a small serial model); K is the (unsymmetric, for non-conservative loads) tangent."""
     import scipy.linalg
 
-    from ..analyses.buckling import constrained_dofs
+    from ..analyses.dofs import constrained_dofs
     from ..analyses.modal import assemble_pair, mass_ufl
     from ..solvers.forms import compile_form
 

@@ -49,7 +49,7 @@ def _run(model_spec, settings, probe):
     normal (planar models), energy record)], result). The tip is read from its dofs."""
     from dolfinx import fem
 
-    from ..analyses.continuation import point_displacement, point_displacement_dofs
+    from ..analyses.dofs import point_displacement, point_displacement_dofs
     from ..analyses.model import BeamModel
     from ..analyses.transient import solve_transient
 
