@@ -10,7 +10,6 @@ from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
-from mpi4py import MPI
 
 from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
