@@ -136,8 +136,9 @@ def _build(scene, comm, log, condense):
 
     points = [*scene.probes.values(), *getattr(scene.settings, "points", lambda: ())()]
     model = build_model(scene.model, comm, points, condense)
-    if model.raised_degree:
-        log(f"note: beams {model.raised_degree} raised to degree {model.degree} (one per mesh)")
+    raised = model.discretisation.raised_degree
+    if raised:
+        log(f"note: beams {raised} raised to degree {model.degree} (one per mesh)")
     log(
         f"model: {len(scene.model.beams)} beam(s), "
         f"{model.mesh.mesh.topology.index_map(1).size_global} elements, degree {model.degree}, "
@@ -155,7 +156,7 @@ def _context(scene, out, comm, log, restart, pictures):
     trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
     log(f"model: {trimming_summary(trim, model.kin, model.unknowns())[0]}")
     if scene.condense:
-        per_node = 3 + model.full.kin.rotation_size
+        per_node = 3 + model.kin.rotation_size
         log(
             "model: statically condensed (a cantilever under point loads): the rotations are "
             f"the only unknowns, 3 per node instead of {per_node}, {model.unknowns()} instead of "

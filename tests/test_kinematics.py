@@ -112,7 +112,7 @@ def test_rotation_matrices_stay_orthonormal_at_quadrature_points():
     solve_static(m, steps=6)
     _, q = ufl.split(m.w)
     R = rotation(q)
-    err = ufl.inner(R.T * R - ufl.Identity(3), R.T * R - ufl.Identity(3)) * m.dx
+    err = ufl.inner(R.T * R - ufl.Identity(3), R.T * R - ufl.Identity(3)) * m.discretisation.dx
     val = MPI.COMM_WORLD.allreduce(
         __import__("dolfinx").fem.assemble_scalar(compile_form(err)), op=MPI.SUM
     )

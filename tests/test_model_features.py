@@ -248,7 +248,7 @@ at = "a:start"
 fix = "all"
 """
     model = BeamModel(scene(text).model)
-    assert model.degree == 3 and model.raised_degree == ["a"]
+    assert model.degree == 3 and model.discretisation.raised_degree == ["a"]
 
 
 def test_t_joint_connects_and_separate_beams_need_their_own_supports():

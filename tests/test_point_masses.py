@@ -137,8 +137,12 @@ def test_point_kinetic_energy_is_half_the_point_mass_form():
     def mass(pm):
         return point_mass_form(kin, rot, v, dw, pm.mass, pm.inertia)
 
-    two_T = 2 * dolfinx.fem.assemble_scalar(dolfinx.fem.form(model.point_mass_terms(kinetic)))
-    M = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(model.point_mass_terms(mass)))
+    two_T = 2 * dolfinx.fem.assemble_scalar(
+        dolfinx.fem.form(model.discretisation.point_mass_terms(kinetic))
+    )
+    M = dolfinx.fem.petsc.assemble_matrix(
+        dolfinx.fem.form(model.discretisation.point_mass_terms(mass))
+    )
     M.assemble()
     y = M.createVecLeft()
     M.mult(z.vector, y)

@@ -109,7 +109,7 @@ def penalty_tangent(model):
     if not model.kin.finite:
         return None
     rot = ufl.split(model.w)[1]
-    Pi = energy.quaternion_penalty(rot, model.k_penalty, model.dx)
+    Pi = energy.quaternion_penalty(rot, model.k_penalty, model.discretisation.dx)
     v, dw = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
     return ufl.derivative(ufl.derivative(Pi, model.w, v), model.w, dw)
 
@@ -118,12 +118,12 @@ def stress_stiffness_ufl(model, w_star, dw):
     """K_σ (UFL): second variation at ``model.w`` of ∫ Ṅ·Γ(w) + Ṁ·K(w) ds, with the section
     force and moment rates Ṅ = C_N Γ̇, Ṁ = C_M K̇ at ``w_star`` in the path direction ``dw``
     (both Functions, held fixed)."""
-    kin, t0, Lam0 = model.kin, model.t0, model.Lam0
-    G_star, K_star = strains(kin, *ufl.split(w_star), t0, Lam0)
-    N = model.C_N * ufl.derivative(G_star, w_star, dw)
-    M = model.C_M * ufl.derivative(K_star, w_star, dw)
-    Gamma, K = strains(kin, *ufl.split(model.w), t0, Lam0)
-    Pi = ufl.dot(N, Gamma) * model.dx_shear + ufl.dot(M, K) * model.dx
+    kin, d = model.kin, model.discretisation
+    G_star, K_star = strains(kin, *ufl.split(w_star), d.t0, d.Lam0)
+    N = d.C_N * ufl.derivative(G_star, w_star, dw)
+    M = d.C_M * ufl.derivative(K_star, w_star, dw)
+    Gamma, K = strains(kin, *ufl.split(model.w), d.t0, d.Lam0)
+    Pi = ufl.dot(N, Gamma) * d.dx_shear + ufl.dot(M, K) * d.dx
     v, dw_ = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
     return ufl.derivative(ufl.derivative(Pi, model.w, v), model.w, dw_)
 

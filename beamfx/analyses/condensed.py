@@ -14,22 +14,20 @@ n depends on the rotation there. The residual takes F as a constant set from the
 before each assembly; the tangent adds the missing rank-3 term −λ G (∂F/∂g_a) with
 G_i = ∂/∂g ∫₀^{s_a} e_i·x' ds (:class:`FollowerCoupling`), so Newton converges quadratically.
 
-Output: the object has what the probes and field writers read (``mesh``, ``degree``, ``comm``,
-``kin``, ``w``, :meth:`section_parts`). The displacement is integrated from x' = R(t0 + Λ0 Γ)
+Output: the object is a :class:`~beamfx.analyses.formulation.Formulation`, so the probes and
+field writers read it like the full model (:meth:`section_parts`, :meth:`sync`). The displacement is integrated from x' = R(t0 + Λ0 Γ)
 cell by cell (:meth:`sync`, exact to quadrature); the section force is the statically
 determined one, in section axes Λ0ᵀRᵀn.
 """
-
-from dataclasses import replace
 
 import numpy as np
 import ufl
 from mpi4py import MPI
 
 from ..physics import condensed as rod
-from ..physics.kinematics import Kinematics
 from ..physics.rotations import np_exp_rotation
-from .dofs import constrained_dofs, owned_size
+from .discretisation import Discretised, discretise
+from .dofs import constrained_dofs, global_size, owned_size
 from .spec import DOF_NAMES, resolve_point
 
 #: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
@@ -91,7 +89,7 @@ class FollowerCoupling:
 
         self.model, self.forces = model, forces  # [(Constant F, f0, point, G forms)]
         self.G = [[fem.petsc.create_vector(G_i) for G_i in f[3]] for f in forces]
-        V = model.V
+        V = model.W
         self._bc_dofs = constrained_dofs(model.bcs)
         owned = owned_size(V)
         self._rows = np.arange(owned, dtype=np.int32)
@@ -102,7 +100,7 @@ class FollowerCoupling:
         """Global indices of the three dofs of g at a named point (every rank)."""
         from dolfinx import fem
 
-        m, V = self.model.mesh.mesh, self.model.V
+        m, V = self.model.mesh.mesh, self.model.W
         verts = self.model.mesh.point_tags.find(self.model.mesh.points[at][0])
         local = fem.locate_dofs_topological(V, 0, verts)
         owned = [d for d in local if d < V.dofmap.index_map.size_local]
@@ -163,50 +161,40 @@ class FollowerCoupling:
                 v.destroy()
 
 
-class CondensedModel:
-    """The statically condensed beam of a :class:`~beamfx.analyses.spec.Model` (see the module doc).
-
-    Attributes as :class:`~beamfx.analyses.model.BeamModel` where the solvers and writers use
-    them (``mesh``, ``degree``, ``comm``, ``kin``, ``w``, ``F``, ``J``, ``bcs``,
-    ``load_factor``, ``t0``, ``Lam0``, ``C_M``), plus ``V`` (the space of g), ``coupling``
-    (follower forces, or None) and ``full``, the BeamModel of the same mesh that supplies the
-    frames and stiffnesses (its forms are never compiled).
+class CondensedModel(Discretised):
+    """The statically condensed beam of a :class:`~beamfx.analyses.spec.Model` (see the module
+    doc): a :class:`~beamfx.analyses.formulation.Formulation` whose unknown ``w`` is the
+    rotation vector field g on ``W`` (P_k, 3 components), plus ``u`` (the displacement, derived
+    by :meth:`sync`) and ``coupling`` (the follower forces' tangent terms, or None).
     """
 
     def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=()):
         from dolfinx import fem
-
-        from .model import BeamModel
+        from petsc4py import PETSc
 
         why = condensed_fit(model)
         if why:
             raise ValueError(f"the statically condensed model does not apply: {why}")
-        self.spec = model
-        kin = Kinematics(
-            finite=True, shear=model.kinematics.shear, stretch=model.kinematics.stretch
-        )
-        self.full = full = BeamModel(replace(model, kinematics=kin), comm, extra_points)
-        self.kin = kin
-        self.mesh, self.comm, self.degree = full.mesh, comm, full.degree
-        self.named, self.raised_degree = full.named, full.raised_degree
-        self.t0, self.Lam0, self.C_N, self.C_M = full.t0, full.Lam0, full.C_N, full.C_M
-        self.load_factor, self.stiffness = full.load_factor, full.stiffness
-        C, kin = full.stiffness, model.kinematics
+        # finite, spatial kinematics (condensed_fit); shear and stretch decide the compliance
+        self.spec, self.kin = model, model.kinematics
+        self.discretisation = d = discretise(model, comm, extra_points)
+        m, p = d.mesh.mesh, d.degree
+        self.load_factor = fem.Constant(m, PETSc.ScalarType(0.0))
+        C, kin = d.stiffness, self.kin
         self.compliance = ufl.diag(  # C_N⁻¹, zero where the scene drops stretch or shear
             ufl.as_vector(
                 [1 / C[0] if kin.stretch else 0.0]
                 + [1 / C[i] if kin.shear else 0.0 for i in (1, 2)]
             )
         )
-        m, p = self.mesh.mesh, self.degree
-        self.V = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
-        self.w = fem.Function(self.V, name="rotation_vector")
-        self.u = fem.Function(self.V, name="displacement")  # derived: :meth:`sync`
+        self.W = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
+        self.w = fem.Function(self.W, name="rotation_vector")
+        self.u = fem.Function(self.W, name="displacement")  # derived: :meth:`sync`
         self.dx = ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p + 2})
         self._build_forms()
         verts = self.mesh.point_tags.find(self.mesh.points[model.supports[0].at][0])
-        clamp = fem.locate_dofs_topological(self.V, 0, verts)
-        self.bcs = [fem.dirichletbc(np.zeros(3), clamp, self.V)]
+        clamp = fem.locate_dofs_topological(self.W, 0, verts)
+        self.bcs = [fem.dirichletbc(np.zeros(3), clamp, self.W)]
         self.coupling = FollowerCoupling(self, self._followers) if self._followers else None
         self._integrator = None
 
@@ -214,11 +202,11 @@ class CondensedModel:
 
     def _before(self, at):
         """DG0 indicator of the cells between the clamp and the named point."""
-        from .model import _dg0
-
         s_a = resolve_point(self.spec, at)[1]
         span = self.mesh.cell_span
-        return _dg0(self.mesh.mesh, (np.max(span, axis=1) <= s_a + 1e-12 * (1 + s_a)) * 1.0)
+        return self.discretisation.cell_function(
+            (np.max(span, axis=1) <= s_a + 1e-12 * (1 + s_a)) * 1.0
+        )
 
     def _build_forms(self):
         from dolfinx import fem
@@ -226,7 +214,8 @@ class CondensedModel:
 
         from ..solvers.forms import compile_form
 
-        g, v, m = self.w, ufl.TestFunction(self.V), self.mesh.mesh
+        d = self.discretisation
+        g, v, m = self.w, ufl.TestFunction(self.W), self.mesh.mesh
         self._forces, followers, moments = [], [], 0
         for ld in self.spec.point_loads:
             if any(ld.force):
@@ -237,15 +226,15 @@ class CondensedModel:
                 if ld.kind == "follower":
                     followers.append((F, np.asarray(ld.force, float), ld.at, before))
             if any(ld.moment):
-                moments += self.full._at_point(ld.at, self._moment_work(ld, g, v))
+                moments += d.at_point(ld.at, self._moment_work(ld, g, v))
         n = self.load_factor * self.section_force()
-        Pi = rod.bending_energy(g, self.t0, self.Lam0, self.C_M, self.dx) - rod.load_potential(
-            g, n, self.t0, self.Lam0, self.compliance, self.dx
+        Pi = rod.bending_energy(g, d.t0, d.Lam0, d.C_M, self.dx) - rod.load_potential(
+            g, n, d.t0, d.Lam0, self.compliance, self.dx
         )
         self.F = ufl.derivative(Pi, g, v) - self.load_factor * moments
-        self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.V))
+        self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.W))
         self.work = None  # the residual is not linear in the load factor (arc length: no)
-        self.x_dot = rod.position_rate(g, n, self.t0, self.Lam0, self.compliance)
+        self.x_dot = rod.position_rate(g, n, d.t0, d.Lam0, self.compliance)
         # follower forces: ∂(residual)/∂(force at the point), for the tangent's rank-3 term
         self._followers = [
             (
@@ -279,8 +268,8 @@ class CondensedModel:
         self.load_factor.value = lam
 
     def unknowns(self):
-        im = self.V.dofmap.index_map
-        return im.size_global * self.V.dofmap.index_map_bs
+        """Global number of unknowns (three per node)."""
+        return global_size(self.W)
 
     def largest_angle(self):
         """Largest nodal rotation angle |ψ| (the parametrisation is singular at 2π)."""
@@ -308,12 +297,12 @@ class CondensedModel:
         """(X, u, quaternion, Λ0, N, M) as UFL, for :func:`beamfx.io._sections.section_expression`."""
         from ..physics.rotations import rotation
 
-        g = self.w
+        d, g = self.discretisation, self.w
         R = rotation(rod.rotation_quaternion(g))
-        N = self.Lam0.T * (R.T * (self.load_factor * self.section_force()))
-        M = self.C_M * rod.curvature(g, self.t0, self.Lam0)
+        N = d.Lam0.T * (R.T * (self.load_factor * self.section_force()))
+        M = d.C_M * rod.curvature(g, d.t0, d.Lam0)
         X = ufl.SpatialCoordinate(self.mesh.mesh)
-        return X, self.u, rod.rotation_quaternion(g), self.Lam0, N, M
+        return X, self.u, rod.rotation_quaternion(g), d.Lam0, N, M
 
     def sync(self):
         """Integrate the displacement u = ∫ (x' − t0) ds from the clamp into ``self.u``.
@@ -326,15 +315,16 @@ class CondensedModel:
 
         from ..solvers.forms import JIT_PARAMS
 
-        V, m = self.V, self.mesh.mesh
+        V, m = self.W, self.mesh.mesh
         xi = np.asarray(V.element.interpolation_points()).reshape(-1)  # node order of a cell
         if self._integrator is None:
             gx, gw = np.polynomial.legendre.leggauss(self.degree + 2)
             points = (xi[:, None] * (gx[None, :] + 1) / 2).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| u'
-            u_xi = ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.t0)
+            u_xi = ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.discretisation.t0)
             expr = fem.Expression(u_xi, points, jit_params=dict(JIT_PARAMS))
-            s_ends = self.full._cell_arc_lengths([0.0, 1.0])  # arc length at vertex 0 and 1
+            # arc length at vertex 0 and 1 of each cell
+            s_ends = self.discretisation.cell_arc_lengths([0.0, 1.0])
             self._integrator = (expr, gw / 2, s_ends)
         expr, gw, s_ends = self._integrator
         n = m.topology.index_map(1).size_local

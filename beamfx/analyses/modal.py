@@ -32,8 +32,9 @@ def mass_ufl(model, rotary="full"):
     v = ufl.split(ufl.TestFunction(model.W))
     dw = ufl.split(ufl.TrialFunction(model.W))
     rot = ufl.split(model.w)[1]
-    m = mass_form(model.kin, rot, v, dw, model.inertia, model.Lam0, model.dx, rotary)
-    return m + model.point_mass_terms(
+    d = model.discretisation
+    m = mass_form(model.kin, rot, v, dw, d.inertia, d.Lam0, d.dx, rotary)
+    return m + d.point_mass_terms(
         lambda pm: point_mass_form(model.kin, rot, v, dw, pm.mass, pm.inertia)
     )
 

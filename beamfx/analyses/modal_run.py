@@ -42,7 +42,8 @@ class Result(_Base):
 def _check_mass(model, ctx):
     from mpi4py import MPI
 
-    mass = model.comm.allreduce(float(np.max(model.inertia.x.array, initial=0.0)), op=MPI.MAX)
+    inertia = model.discretisation.inertia.x.array
+    mass = model.comm.allreduce(float(np.max(inertia, initial=0.0)), op=MPI.MAX)
     if mass <= 0 and not ctx.spec.point_masses:
         raise ValueError(
             f"{ctx.file}: a modal analysis needs mass: give [material] rho, or rho_A and "

@@ -71,22 +71,23 @@ class RotatingFrame:
         test, trial = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
         (u, rot), (v_u, v_rot) = ufl.split(w), ufl.split(test)
         r = relative_position(ufl.SpatialCoordinate(m), displacement(kin, u), self.hub)
-        rho_A = model.inertia[0]
-        rho_I = [model.inertia[i] for i in (1, 2, 3)]
-        J = spatial_inertia(kin, rot, model.Lam0, rho_I) if rotary == "full" else ufl.zero((3, 3))
+        d = model.discretisation
+        rho_A = d.inertia[0]
+        rho_I = [d.inertia[i] for i in (1, 2, 3)]
+        J = spatial_inertia(kin, rot, d.Lam0, rho_I) if rotary == "full" else ufl.zero((3, 3))
         v_u3, v_theta = displacement(kin, v_u), spatial_virtual_rotation(kin, rot, v_rot)
 
         def point_J(pm):
             return point_inertia(kin, rot, pm.inertia)
 
-        V_c = centrifugal_potential(rho_A, J, self.omega, r) * model.dx
-        V_c += model.point_mass_terms(
+        V_c = centrifugal_potential(rho_A, J, self.omega, r) * d.dx
+        V_c += d.point_mass_terms(
             lambda pm: centrifugal_potential(float(pm.mass), point_J(pm), self.omega, r)
         )
         self.F = model.F + model.load_factor * ufl.derivative(V_c, w, test)
         self.J = ufl.derivative(self.F, w, trial)
-        a = gyroscopic_covector(rho_A, J, self.omega, r, v_u3, v_theta) * model.dx
-        a += model.point_mass_terms(
+        a = gyroscopic_covector(rho_A, J, self.omega, r, v_u3, v_theta) * d.dx
+        a += d.point_mass_terms(
             lambda pm: gyroscopic_covector(
                 float(pm.mass), point_J(pm), self.omega, r, v_u3, v_theta
             )
@@ -121,7 +122,8 @@ class RotatingFrame:
         model = self.model
         if self._stretch is None:
             u, rot = ufl.split(model.w)
-            Gamma, _ = strains(model.kin, u, rot, model.t0, model.Lam0)
+            d = model.discretisation
+            Gamma, _ = strains(model.kin, u, rot, d.t0, d.Lam0)
             points = np.linspace(0.0, 1.0, model.degree + 2)[:, None]
             self._stretch = fem.Expression(1 + Gamma[0], points, jit_params=JIT_PARAMS)
         n = model.mesh.mesh.topology.index_map(1).size_local

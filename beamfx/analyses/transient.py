@@ -100,7 +100,7 @@ class Dynamics:
         from petsc4py import PETSc
 
         self.model, self.settings = model, settings
-        W, w, kin = model.W, model.w, model.kin
+        W, w, kin, d = model.W, model.w, model.kin, model.discretisation
         self.q_n, self.v_n, self.a_n, self.qdd_n = (fem.Function(W) for _ in range(4))
         # dofs per node: displacement (with the nodes' reference positions) and rotation
         V_u, u_dofs = W.sub(0).collapse()
@@ -126,11 +126,9 @@ class Dynamics:
 
         def T_of(q, v):
             (_, rot), (u_dot, rot_dot) = ufl.split(q), ufl.split(v)
-            T = kinetic_energy(
-                kin, rot, u_dot, rot_dot, model.inertia, model.Lam0, settings.rotary_inertia
-            )
+            T = kinetic_energy(kin, rot, u_dot, rot_dot, d.inertia, d.Lam0, settings.rotary_inertia)
             u_dot3, omega = displacement(kin, u_dot), angular_velocity(kin, rot, rot_dot)
-            return T * model.dx + model.point_mass_terms(
+            return T * d.dx + d.point_mass_terms(
                 lambda pm: point_kinetic_energy(kin, rot, u_dot3, omega, pm.mass, pm.inertia)
             )
 
@@ -143,9 +141,9 @@ class Dynamics:
             power += a0 * 2 * T
         if settings.damping_stiffness:
             u, rot = ufl.split(w)
-            Gamma, K = strains(kin, u, rot, model.t0, model.Lam0)
+            Gamma, K = strains(kin, u, rot, d.t0, d.Lam0)
             rate = [ufl.derivative(x, w, V) for x in (Gamma, K)]
-            D = strain_rate_dissipation(*rate, model.C_N, model.C_M, a1, model.dx_shear, model.dx)
+            D = strain_rate_dissipation(*rate, d.C_N, d.C_M, a1, d.dx_shear, d.dx)
             inertia += ufl.derivative(D, V, test)
             power += 2 * D
         v_expr, qdd_expr = self.scheme.rates(w, self.q_n, self.v_n, self.a_n, self.qdd_n)
@@ -166,15 +164,15 @@ class Dynamics:
         from ..physics.inertia import angular_velocity, point_inertia, spatial_inertia
         from ..physics.kinematics import displacement
 
-        m, kin = self.model, self.model.kin
+        m, kin, d = self.model, self.model.kin, self.model.discretisation
         (u, rot), (u_dot, rot_dot) = ufl.split(m.w), ufl.split(self.v_n)
         velocity = displacement(kin, u_dot)
         x = ufl.SpatialCoordinate(m.mesh.mesh) + displacement(kin, u)
         omega = angular_velocity(kin, rot, rot_dot)
-        p = m.inertia[0] * velocity
+        p = d.inertia[0] * velocity
         L = ufl.cross(x, p)
         if rotary != "none":
-            J = spatial_inertia(kin, rot, m.Lam0, [m.inertia[i] for i in (1, 2, 3)], rotary)
+            J = spatial_inertia(kin, rot, d.Lam0, [d.inertia[i] for i in (1, 2, 3)], rotary)
             L += J * omega
 
         def point_p(pm):
@@ -184,8 +182,8 @@ class Dynamics:
             return ufl.cross(x, point_p(pm)) + point_inertia(kin, rot, pm.inertia) * omega
 
         return [
-            p[i] * m.dx + m.point_mass_terms(lambda pm, i=i: point_p(pm)[i]) for i in range(3)
-        ] + [L[i] * m.dx + m.point_mass_terms(lambda pm, i=i: point_L(pm)[i]) for i in range(3)]
+            p[i] * d.dx + d.point_mass_terms(lambda pm, i=i: point_p(pm)[i]) for i in range(3)
+        ] + [L[i] * d.dx + d.point_mass_terms(lambda pm, i=i: point_L(pm)[i]) for i in range(3)]
 
     def start(self):
         """State at t = 0 from the model's current unknowns, at rest (q̇ = q̈ = a = 0)."""

@@ -103,7 +103,7 @@ def first_flap_and_lead_lag(frame, alpha, n_modes=4):
 def set_stiff_terms(model, f, alpha, extensible):
     """Put :func:`stiff_terms` into the model's stiffness field (in place: no new forms)."""
     GA_y, GA_z, EA = stiff_terms(f, alpha)
-    C = model.stiffness.x.array.reshape(-1, 6)
+    C = model.discretisation.stiffness.x.array.reshape(-1, 6)
     C[:, 1], C[:, 2] = GA_y, GA_z
     if not extensible:
         C[:, 0] = EA

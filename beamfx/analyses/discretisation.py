@@ -1,0 +1,271 @@
+"""The discretisation of a beam model that every formulation shares: mesh, named points,
+section fields, reference frames and measures; everything but the unknowns and the energy.
+
+:func:`discretise` builds it once from a :class:`~beamfx.analyses.spec.Model`. The full and
+planar :class:`~beamfx.analyses.model.BeamModel` and the statically condensed
+:class:`~beamfx.analyses.condensed.CondensedModel` compose one (``model.discretisation``), so a
+scene gives the same mesh, frames and section data whichever formulation solves it.
+
+Section data per cell: the stiffnesses (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertias
+(ρA, ρI_1, ρI_2, ρI_3) are DG_p fields where a section varies along a beam and DG0 otherwise;
+the reference vector and twist are DG0. The measures integrate the shear and axial energy
+with p Gauss points (``dx_shear``, exact to degree 2p − 1: the locking remedy) and the rest
+with p + 1 (``dx``, exact to 2p).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from ..geometry import BeamSpec, build_mesh
+from ..geometry.frames import default_reference
+from ..physics.kinematics import section_frame, tangent
+from .checks import joint_breaks
+from .spec import resolve_point
+
+
+def cell_field(mesh, degree, values):
+    """A DG ``degree`` Function with values (n_cells, points, size) at the interpolation points
+    of each local cell (scalar if size is 1, and then values may be (n_cells, points))."""
+    from dolfinx import fem
+
+    values = np.asarray(values, float)
+    size = 1 if values.ndim == 2 else values.shape[2]
+    cell = mesh.ufl_cell()
+    if size == 1:
+        element = ufl.FiniteElement("DG", cell, degree, variant="equispaced")
+    else:
+        element = ufl.VectorElement("DG", cell, degree, dim=size, variant="equispaced")
+    V = fem.FunctionSpace(mesh, element)
+    f = fem.Function(V)
+    n_points = values.shape[1]
+    dofs = V.dofmap.list.array.reshape(-1, n_points)[: len(values)]
+    f.x.array.reshape(-1, size)[dofs.ravel()] = values.reshape(-1, size)
+    return f
+
+
+def cell_function(mesh, values):
+    """A DG0 Function (scalar or vector) with the given per-local-cell values."""
+    values = np.asarray(values, float)
+    return cell_field(mesh, 0, values[:, None])
+
+
+def cell_arc_lengths(spec, mesh, X):
+    """Arc length of the reference points ``X`` (in [0, 1]) of each local cell of ``mesh`` (a
+    :class:`~beamfx.geometry.BeamMesh` of the beams of ``spec``): (n_cells, len(X))."""
+    m, spans = mesh.mesh, mesh.cell_span
+    n = len(spans)
+    nodes = m.geometry.dofmap.array.reshape(-1, mesh.degree + 1)[:n]
+    x0 = m.geometry.x[nodes[:, 0]]
+    flipped = np.zeros(n, bool)  # DOLFINx may reverse a cell: its vertex 0 is then at s_b
+    for i, b in enumerate(spec.beams):
+        sel = mesh.cell_beam == i
+        if np.any(sel):
+            at_a = np.linalg.norm(x0[sel] - b.curve.points(spans[sel, 0]), axis=1)
+            at_b = np.linalg.norm(x0[sel] - b.curve.points(spans[sel, 1]), axis=1)
+            flipped[sel] = at_b < at_a
+    s0 = np.where(flipped, spans[:, 1], spans[:, 0])
+    s1 = np.where(flipped, spans[:, 0], spans[:, 1])
+    return s0[:, None] + np.asarray(X)[None, :] * (s1 - s0)[:, None]
+
+
+def _section_fields(spec, mesh, comm):
+    """Stiffness (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertia (rho_A, rho_I) fields, the
+    shear-rigid/inextensible limits of ``spec.kinematics`` applied; and the largest EA or GA
+    before the limits (over all ranks)."""
+    kin, beams, cb = spec.kinematics, spec.beams, mesh.cell_beam
+    varies = any(b.section.varies for b in beams)
+    q = mesh.degree if varies else 0
+    X = np.r_[0.0, 1.0, np.arange(1, q) / q] if q else np.array([0.5])  # basix DG order
+    S = cell_arc_lengths(spec, mesh, X)
+    stiff = np.zeros((len(cb), len(X), 6))
+    mass = np.zeros((len(cb), len(X), 4))
+    raw_max = 0.0
+    for i, b in enumerate(beams):
+        sel = cb == i
+        samples = b.section.along(S[sel].ravel()) if np.any(sel) else b.section.along([0.0])
+        raw_max = max(raw_max, max(max(x.EA, x.GA_y, x.GA_z) for x in samples))
+        limited = {}
+        for x in samples:
+            if id(x) not in limited:
+                limited[id(x)] = x.with_limits(not kin.shear, not kin.stretch, b.curve.length)
+        stiff[sel] = np.array([limited[id(x)].stiffnesses() for x in samples]).reshape(
+            -1, len(X), 6
+        )[: np.count_nonzero(sel)]
+        mass[sel] = np.array([x.inertias() for x in samples]).reshape(-1, len(X), 4)[
+            : np.count_nonzero(sel)
+        ]
+    if np.any(stiff <= 0):
+        raise ValueError("a section stiffness is not positive somewhere along a beam")
+    raw_max = comm.allreduce(raw_max, op=MPI.MAX)
+    m = mesh.mesh
+    return cell_field(m, q, stiff), cell_field(m, q, mass), raw_max
+
+
+def _cell_tangents(mesh):
+    """Unit chord of each local cell, from its vertex 0 to its vertex 1."""
+    m = mesh.mesh
+    nodes = m.geometry.dofmap.array.reshape(-1, mesh.degree + 1)[: len(mesh.cell_beam)]
+    d = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]
+    return d / np.maximum(np.linalg.norm(d, axis=1)[:, None], 1e-300)
+
+
+def _beam_mesh(spec, comm, degree, extra_points):
+    """Named points (every 'at' of supports, loads, springs, masses and ``extra_points``) as
+    {at: (beam, s, xyz)} and the mesh with a vertex at each of them and at T-joints."""
+    ats = [x.at for x in (*spec.supports, *spec.point_loads, *spec.springs, *spec.point_masses)]
+    named = {at: resolve_point(spec, at) for at in dict.fromkeys(ats + list(extra_points))}
+    breaks = {i: [] for i in range(len(spec.beams))}
+    for b, s, _ in named.values():
+        breaks[b].append(s)
+    for b, s in joint_breaks(spec):
+        breaks[b].append(s)
+    specs = [
+        BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i])) for i, b in enumerate(spec.beams)
+    ]
+    points = {at: xyz for at, (_, _, xyz) in named.items()}
+    return named, build_mesh(comm, specs, degree, points)
+
+
+def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
+    """The :class:`Discretisation` of the model ``spec``. Collective.
+
+    Args:
+        spec: :class:`~beamfx.analyses.spec.Model`; its kinematics' ``shear`` and ``stretch``
+            decide the section limits (the other kinematic options do not enter).
+        comm: MPI communicator.
+        extra_points: names (``beam:where``) that must be mesh vertices too (probes).
+    """
+    # one DOLFINx mesh holds one element type: every beam gets the highest degree asked for
+    p = max(b.degree for b in spec.beams)
+    named, mesh = _beam_mesh(spec, comm, p, extra_points)
+    m, cb = mesh.mesh, mesh.cell_beam
+    stiffness, inertia, raw_max = _section_fields(spec, mesh, comm)
+    ref = default_reference(_cell_tangents(mesh))
+    for i, b in enumerate(spec.beams):
+        if b.orientation is not None:
+            ref[cb == i] = b.orientation
+    reference = cell_function(m, ref)
+    twist = cell_function(m, np.deg2rad([spec.beams[b].twist_deg for b in cb]))
+    t0 = tangent(m)
+    C = stiffness
+    return Discretisation(
+        spec=spec,
+        comm=comm,
+        mesh=mesh,
+        degree=p,
+        raised_degree=[b.name for b in spec.beams if b.degree < p],
+        named=named,
+        stiffness=stiffness,
+        inertia=inertia,
+        stiffness_scale=raw_max,
+        reference=reference,
+        twist=twist,
+        t0=t0,
+        Lam0=section_frame(t0, reference, twist),
+        C_N=ufl.diag(ufl.as_vector([C[0], C[1], C[2]])),
+        C_M=ufl.diag(ufl.as_vector([C[3], C[4], C[5]])),
+        dx_shear=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p - 1}),
+        dx=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p}),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class Discretisation:
+    """Mesh, named points, section fields, frames and measures of a model (:func:`discretise`).
+
+    UFL members are expressions of the reference configuration; vectors are in global axes
+    and Λ0 maps section axes to global ones (columns t0, e2, e3).
+    """
+
+    spec: object  #: the :class:`~beamfx.analyses.spec.Model` discretised
+    comm: object  #: MPI communicator
+    mesh: object  #: :class:`~beamfx.geometry.BeamMesh` (P_degree geometry, named point tags)
+    degree: int  #: polynomial degree of the geometry and of every field on it
+    raised_degree: list  #: names of the beams raised to ``degree`` (one degree per mesh)
+    named: dict  #: {point name: (beam index, arc length, xyz)} of every vertex-named point
+    stiffness: object  #: DG Function (EA, GA_y, GA_z, GJ, EI_y, EI_z), limits applied
+    inertia: object  #: DG Function (ρA, ρI_1, ρI_2, ρI_3)
+    stiffness_scale: float  #: largest EA, GA_y or GA_z before the limits (all ranks)
+    reference: object  #: DG0 Function: orientation vector of each cell (global axes)
+    twist: object  #: DG0 Function: twist of each cell (radians)
+    t0: object  #: UFL unit tangent of the reference centre line
+    Lam0: object  #: UFL reference section frame Λ0 (columns t0, e2, e3)
+    C_N: object  #: UFL diag(EA, GA_y, GA_z)
+    C_M: object  #: UFL diag(GJ, EI_y, EI_z)
+    dx_shear: object  #: measure of the shear and axial energy (degree 2p − 1)
+    dx: object  #: measure of everything else (degree 2p)
+
+    def cell_arc_lengths(self, X):
+        """Arc length of the reference points ``X`` (in [0, 1]) of each local cell."""
+        return cell_arc_lengths(self.spec, self.mesh, X)
+
+    def cell_function(self, values):
+        """A DG0 Function with the given per-local-cell values (:func:`cell_function`)."""
+        return cell_function(self.mesh.mesh, values)
+
+    def beam_indicator(self, beam_index):
+        """DG0 Function: 1 on the cells of one beam, 0 elsewhere."""
+        per_beam = [1.0 if i == beam_index else 0.0 for i in range(len(self.spec.beams))]
+        return self.cell_function(np.asarray(per_beam, float)[self.mesh.cell_beam])
+
+    def min_cell_length(self):
+        """Shortest cell, in arc length (all ranks). Collective."""
+        return self.comm.allreduce(np.min(np.diff(self.mesh.cell_span, axis=1)), op=MPI.MIN)
+
+    def point_measure(self, at):
+        """``ds`` at an end vertex, ``dS`` (with '+' restriction) at an inner vertex: the
+        measure of the named point ``at`` and its restriction (None or "+"). Collective.
+
+        Raises:
+            ValueError: if more than two elements meet at the point.
+        """
+        tag = self.mesh.points[at][0]
+        m = self.mesh.mesh
+        m.topology.create_connectivity(0, 1)
+        c = m.topology.connectivity(0, 1)
+        vertices = self.mesh.point_tags.find(tag)
+        n_local = max([len(c.links(v)) for v in vertices], default=0)
+        if self.comm.allreduce(n_local, op=MPI.MAX) > 2:
+            raise ValueError(
+                f"{at!r} joins more than two elements: loads and springs there are not supported"
+            )
+        inner = self.comm.allreduce(n_local, op=MPI.MAX) == 2
+        if inner:
+            return ufl.dS(domain=m, subdomain_data=self.mesh.point_tags)(tag), "+"
+        return ufl.ds(domain=m, subdomain_data=self.mesh.point_tags)(tag), None
+
+    def at_point(self, at, integrand):
+        """``integrand`` integrated at the named point (restricted there if it is inside)."""
+        dP, side = self.point_measure(at)
+        return (integrand(side) if side else integrand) * dP
+
+    def point_mass_terms(self, integrand):
+        """Σ over the scene's point masses of ``integrand(point_mass)`` (UFL) at its point; 0 if
+        there are none. E.g. the mass form with :func:`~beamfx.physics.inertia.point_mass_form`,
+        or the kinetic energy with :func:`~beamfx.physics.inertia.point_kinetic_energy`."""
+        return sum((self.at_point(pm.at, integrand(pm)) for pm in self.spec.point_masses), start=0)
+
+
+class Discretised:
+    """The shorthands of :class:`~beamfx.analyses.formulation.Formulation` for a class with a
+    ``discretisation``: ``comm``, ``mesh`` and ``degree`` are the discretisation's."""
+
+    discretisation: Discretisation
+
+    @property
+    def comm(self):
+        """MPI communicator (``discretisation.comm``)."""
+        return self.discretisation.comm
+
+    @property
+    def mesh(self):
+        """:class:`~beamfx.geometry.BeamMesh` (``discretisation.mesh``)."""
+        return self.discretisation.mesh
+
+    @property
+    def degree(self):
+        """Polynomial degree of the fields (``discretisation.degree``)."""
+        return self.discretisation.degree
