@@ -131,7 +131,7 @@ class Projection:
 
         b = self.balance
         operators = self._operators()  # q is not changed by the projection: assembled once
-        Pi = b._scalar(b.Pi)
+        Pi = b.scalar(b.Pi)
         if self.applies and self._load_free(t_n) and self._load_free(t):
             H0, g0 = self.target
             v = self.dyn.v_n.vector
@@ -143,7 +143,7 @@ class Projection:
                     v.axpy(-ck, rk)  # the flexible part
                 T_rigid = 0.5 * c_new @ G @ c_new
             v.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-            T_flex = b._scalar(b.T)
+            T_flex = b.scalar(b.T)
             room = H0 - Pi - T_rigid
             alpha = np.sqrt(room / T_flex) if room > 0 and T_flex > 1e-14 * abs(H0) else 1.0
             v.scale(alpha)
@@ -155,11 +155,11 @@ class Projection:
 
     def remember(self):
         """Take the current state's energy and momenta as the target (start, restart)."""
-        self._remember(self._operators(), self.balance._scalar(self.balance.Pi))
+        self._remember(self._operators(), self.balance.scalar(self.balance.Pi))
 
     def _remember(self, operators, Pi):
         """The target from the current velocities (energy and momenta measured, not assumed,
         so round-off does not accumulate unseen)."""
-        self.target = (self.balance._scalar(self.balance.T) + Pi, self._momenta(operators))
+        self.target = (self.balance.scalar(self.balance.T) + Pi, self._momenta(operators))
         for vec in (*operators[0], *operators[1]) if operators is not None else ():
             vec.destroy()

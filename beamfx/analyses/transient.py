@@ -285,7 +285,8 @@ class EnergyBalance:
         self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
         self.previous = self.initial = None
 
-    def _scalar(self, form):
+    def scalar(self, form):
+        """Value of a compiled scalar form (e.g. ``T``, ``Pi``) over all ranks. Collective."""
         from dolfinx import fem
 
         return self.dyn.model.comm.allreduce(fem.assemble_scalar(form))
@@ -312,7 +313,7 @@ class EnergyBalance:
         now = {
             "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
             "reaction": self._reaction,
-            "power": self._scalar(self.P) if self.P is not None else 0.0,
+            "power": self.scalar(self.P) if self.P is not None else 0.0,
         }
         if self.previous is not None:
             dq = q - q_old[owned]
@@ -328,9 +329,9 @@ class EnergyBalance:
                 self.values["work_supports"] += trapezoid("reaction")
             self.values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
         self.previous = now
-        out = {"kinetic": self._scalar(self.T), "strain": self._scalar(self.Pi), **self.values}
+        out = {"kinetic": self.scalar(self.T), "strain": self.scalar(self.Pi), **self.values}
         if self.momenta:
-            momenta = [self._scalar(f) for f in self.momenta]
+            momenta = [self.scalar(f) for f in self.momenta]
             out["linear_momentum"], out["angular_momentum"] = momenta[:3], momenta[3:]
         if self.initial is None:
             self.initial = out["kinetic"] + out["strain"]

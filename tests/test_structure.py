@@ -1,0 +1,272 @@
+"""The code's structure, read from its syntax trees: the analyses use formulations only through
+their protocol, no module calls another's private members, and imports have no cycles."""
+
+import ast
+from dataclasses import fields
+from pathlib import Path
+
+import pytest
+
+from beamfx.analyses.discretisation import Discretisation
+from beamfx.analyses.formulation import BEAM_FORMULATION_MEMBERS, FORMULATION_MEMBERS
+
+PACKAGE = Path(__file__).resolve().parents[1] / "beamfx"
+
+#: modules that receive a formulation, and the protocol whose members they may use
+FORMULATION_USERS = {
+    "analyses/static.py": FORMULATION_MEMBERS,
+    "runner.py": FORMULATION_MEMBERS,
+    **{f"io/{p.name}": FORMULATION_MEMBERS for p in (PACKAGE / "io").glob("*.py")},
+    **{
+        f"analyses/{name}.py": BEAM_FORMULATION_MEMBERS
+        for name in (
+            "modal",
+            "buckling",
+            "transient",
+            "continuation",
+            "rotating",
+            "conserving",
+            "campbell",
+            "dofs",
+            "adaptive",
+        )
+    },
+    **{f"analyses/{p.name}": BEAM_FORMULATION_MEMBERS for p in PACKAGE.glob("analyses/*_run.py")},
+}
+#: functions of those modules whose ``model`` is a :class:`~beamfx.analyses.spec.Model`
+SPEC_FUNCTIONS = {"motion_warnings", "with_discretisation"}
+DISCRETISATION_MEMBERS = {f.name for f in fields(Discretisation)} | {
+    name for name in vars(Discretisation) if not name.startswith("_")
+}
+
+
+def _tree(rel):
+    return ast.parse((PACKAGE / rel).read_text(), rel)
+
+
+def _is_model(node, aliases):
+    """``model``, an alias of it, or ``<x>.model`` (but not ``scene.model``, the spec)."""
+    if isinstance(node, ast.Name):
+        return node.id in aliases
+    return (
+        isinstance(node, ast.Attribute)
+        and node.attr == "model"
+        and not (isinstance(node.value, ast.Name) and node.value.id == "scene")
+    )
+
+
+def _pairs(assign):
+    """(target, value) pairs of an assignment, tuples matched element by element."""
+    for target in assign.targets:
+        if isinstance(target, ast.Tuple) and isinstance(assign.value, ast.Tuple):
+            yield from zip(target.elts, assign.value.elts)
+        else:
+            yield target, assign.value
+
+
+def model_attributes(tree):
+    """{(attribute, line)} read on formulations and {(attribute, line)} on their
+    discretisation, per top-level function or method of ``tree``."""
+    on_model, on_disc = set(), set()
+    scopes = [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)]
+    nested = {id(m) for s in scopes for m in ast.walk(s) if m is not s and m in scopes}
+    for scope in (s for s in scopes if id(s) not in nested and s.name not in SPEC_FUNCTIONS):
+        models, discs = {"model"}, set()
+        for node in ast.walk(scope):
+            if isinstance(node, ast.Assign):
+                for target, value in _pairs(node):
+                    if isinstance(target, ast.Name) and _is_model(value, models):
+                        models.add(target.id)
+                    elif (
+                        isinstance(target, ast.Name)
+                        and isinstance(value, ast.Attribute)
+                        and value.attr == "discretisation"
+                        and _is_model(value.value, models)
+                    ):
+                        discs.add(target.id)
+        for node in ast.walk(scope):
+            if not isinstance(node, ast.Attribute):
+                continue
+            if _is_model(node.value, models):
+                on_model.add((node.attr, node.lineno))
+            elif (
+                isinstance(node.value, ast.Attribute)
+                and node.value.attr == "discretisation"
+                and _is_model(node.value.value, models)
+            ) or (isinstance(node.value, ast.Name) and node.value.id in discs):
+                on_disc.add((node.attr, node.lineno))
+    return on_model, on_disc
+
+
+@pytest.mark.parametrize("rel", sorted(FORMULATION_USERS))
+def test_analyses_use_formulations_through_their_protocol(rel):
+    """Every ``model.<name>`` in an analysis or writer is a member of the protocol it may
+    assume (io, static solves and the runner: :class:`Formulation`, which the condensed
+    model provides too), and every ``model.discretisation.<name>`` a Discretisation member."""
+    on_model, on_disc = model_attributes(_tree(rel))
+    allowed = FORMULATION_USERS[rel]
+    assert not {(a, line) for a, line in on_model if a not in allowed}, rel
+    assert not {(a, line) for a, line in on_disc if a not in DISCRETISATION_MEMBERS}, rel
+
+
+def test_the_scan_sees_the_analyses_use_of_models():
+    """The scan is not vacuous: it finds what the modal and transient modules read."""
+    on_model, on_disc = model_attributes(_tree("analyses/transient.py"))
+    assert {"W", "F", "work", "k_penalty", "set_time"} <= {a for a, _ in on_model}
+    assert {"inertia", "Lam0", "point_mass_terms"} <= {a for a, _ in on_disc}
+    tree = ast.parse("def f(model):\n    m = model\n    return m.secret, model.discretisation.x")
+    on_model, on_disc = model_attributes(tree)
+    assert {a for a, _ in on_model} == {"secret", "discretisation"} and on_disc == {("x", 3)}
+
+
+#: packages where no module reads another object's private members
+NO_PRIVATE_CALLS = ("analyses", "io", "continuum", "geometry", "physics", "solvers", "spec")
+#: NamedTuple's public API has leading underscores (to keep clear of field names)
+NAMEDTUPLE_API = {"_asdict", "_replace", "_fields", "_make"}
+#: (module, attribute) that cannot be avoided, with the reason
+PRIVATE_ALLOWED = {
+    # DOLFINx 0.5.2 has no Python wrapper of cpp.mesh.entities_to_geometry, and its C++ mesh is
+    # reachable only as Mesh._mesh (DOLFINx's own plot.py does the same)
+    ("io/probes.py", "_mesh"),
+}
+
+
+def private_reads(tree, rel):
+    """(attribute, line) of ``x._name`` in the module ``rel`` where x is not ``self``/``cls``."""
+    out = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Attribute) or not node.attr.startswith("_"):
+            continue
+        if node.attr.startswith("__") and node.attr.endswith("__"):
+            continue
+        if isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"):
+            continue
+        if node.attr in NAMEDTUPLE_API or (rel, node.attr) in PRIVATE_ALLOWED:
+            continue
+        out.append((node.attr, node.lineno))
+    return out
+
+
+@pytest.mark.parametrize(
+    "rel",
+    sorted(
+        str(p.relative_to(PACKAGE))
+        for package in NO_PRIVATE_CALLS
+        for p in (PACKAGE / package).rglob("*.py")
+    ),
+)
+def test_no_private_cross_calls(rel):
+    assert private_reads(_tree(rel), rel) == []
+
+
+def test_the_private_scan_flags_a_cross_call():
+    code = "class A:\n    def f(self, other):\n        return self._x + other._y + t._replace()\n"
+    assert private_reads(ast.parse(code), "x.py") == [("_y", 3)]
+
+
+# --- imports ----------------------------------------------------------------------------------
+
+
+def import_graph(root):
+    """{module: modules it imports} of the package at ``root`` (function-level imports too:
+    a lazy import still ties the two modules together). ``from package import submodule``
+    points at the submodule, not at the package."""
+    modules = {}
+    for path in root.rglob("*.py"):
+        parts = list(path.relative_to(root.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        modules[".".join(parts)] = path
+    graph = {}
+    for name, path in modules.items():
+        package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        edges = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                edges.update(a.name for a in node.names if a.name in modules)
+            elif isinstance(node, ast.ImportFrom):
+                base = package[: len(package) - node.level + 1] if node.level else []
+                target = ".".join(base + ([node.module] if node.module else []))
+                subs = [f"{target}.{a.name}" for a in node.names]
+                subs = [s for s in subs if s in modules]
+                edges.update(subs)
+                if target in modules and len(subs) < len(node.names):
+                    edges.add(target)
+        graph[name] = edges - {name}
+    return graph
+
+
+def cycles(graph):
+    """Strongly connected components of more than one module (Tarjan), as sorted tuples."""
+    index, low, stack, on_stack, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(tuple(sorted(component)))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+#: packages whose modules are in no import cycle at all
+ACYCLIC = ("analyses", "continuum", "geometry", "io", "physics", "solvers", "spec")
+#: cycles outside those packages that are known and not yet removed (this test only lets them
+#: shrink): the benchmark registry and its case modules, the runner and the sweep
+KNOWN_CYCLES = ({"beamfx.bench"}, {"beamfx.runner", "beamfx.sweep"})
+
+
+def test_no_import_cycles():
+    found = cycles(import_graph(PACKAGE))
+    for component in found:
+        touched = [m for m in component if m.split(".")[1] in ACYCLIC]
+        assert not touched, f"import cycle through {component}"
+        known = any(k <= set(component) for k in KNOWN_CYCLES)
+        assert known, f"new import cycle {component}"
+
+
+def test_the_cycle_scan_finds_a_lazy_import_cycle(tmp_path):
+    pkg = tmp_path / "pkg"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "sub" / "__init__.py").write_text("from . import b\n")
+    (pkg / "a.py").write_text("def f():\n    from .sub.b import g\n")
+    (pkg / "sub" / "b.py").write_text("from ..a import f\n")
+    (pkg / "c.py").write_text("from .sub import b\n")
+    graph = import_graph(pkg)
+    assert graph["pkg.c"] == {"pkg.sub.b"}
+    assert cycles(graph) == [("pkg.a", "pkg.sub.b")]
+
+
+def test_layers():
+    """geometry knows nothing of physics (its frames are NumPy); the model description
+    (spec) imports no analyses."""
+    graph = import_graph(PACKAGE)
+    for name, edges in graph.items():
+        if name.startswith("beamfx.geometry"):
+            assert all(e.startswith("beamfx.geometry") for e in edges), (name, edges)
+        if name.startswith("beamfx.spec"):
+            assert not any(e.startswith("beamfx.analyses") for e in edges), (name, edges)
+    frames = ast.parse((PACKAGE / "geometry" / "frames.py").read_text())
+    imported = {a.name for n in ast.walk(frames) if isinstance(n, ast.Import) for a in n.names} | {
+        n.module for n in ast.walk(frames) if isinstance(n, ast.ImportFrom)
+    }
+    assert imported == {"numpy"}
