@@ -12,8 +12,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import ufl
 
+from ..analyses.discretisation import discretise
+from ..analyses.spec import Beam, Model
+from ..geometry import Line
 from ..geometry.frames import frame_from_tangent
 from ..physics.kinematics import d_ds
+from ..physics.sections import rectangle
 from ..solvers.forms import compile_form
 from . import model as forms
 
@@ -49,11 +53,21 @@ class ContinuumSpec:
     options: dict = field(default_factory=dict)  # PETSc options for Newton (no prefix)
 
 
+def beam_model(spec):
+    """The :class:`~beamfx.analyses.spec.Model` of the same beam for the shared
+    discretisation (:func:`~beamfx.analyses.discretisation.discretise`): one beam "b" along
+    the line with the rectangle's section and the spec's elements and degree."""
+    line = Line(tuple(spec.start), tuple(spec.end))
+    G = spec.E / (2 * (1 + spec.nu))
+    section = rectangle(spec.E, G, spec.rho, spec.h, spec.w, nu=spec.nu)
+    return Model(beams=(Beam("b", line, section, spec.elements, spec.degree),))
+
+
 def reference_frame(start, end):
     """(t0, e2, e3) of a straight beam: e3 = global z made normal to t0 (x if t0 is along z),
     e2 = e3 × t0 (:func:`beamfx.geometry.frames.frame_from_tangent`, no twist)."""
     t0 = np.subtract(end, start) / np.linalg.norm(np.subtract(end, start))
-    return tuple(frame_from_tangent(t0).T)
+    return tuple(np.ascontiguousarray(frame_from_tangent(t0).T))
 
 
 class ContinuumBeam:
@@ -64,31 +78,23 @@ class ContinuumBeam:
         from mpi4py import MPI
         from petsc4py import PETSc
 
-        from ..geometry import BeamSpec, Line, build_mesh
-
         if spec.variant not in forms.VARIANTS:
             raise ValueError(f"variant {spec.variant!r} not allowed; allowed: {forms.VARIANTS}")
+        if spec.axis_quadrature not in ("reduced", "full"):
+            raise ValueError(f"axis_quadrature {spec.axis_quadrature!r}: 'reduced' or 'full'")
         self.spec, self.comm = spec, comm or MPI.COMM_WORLD
-        p = spec.degree
-        line = Line(tuple(spec.start), tuple(spec.end))
-        self.mesh = build_mesh(
-            self.comm,
-            [BeamSpec("b", line, spec.elements)],
-            p,
-            {"start": spec.start, "end": spec.end},
-        )
+        # the Reissner beam's discretisation of the same beam: mesh, end points, measures
+        self.discretisation = d = discretise(beam_model(spec), self.comm, ("b:start", "b:end"))
+        self.mesh, p = d.mesh, spec.degree
         m = self.mesh.mesh
+        # the exact frame of the straight reference (constants, not the mesh's Λ0)
         self.frame = reference_frame(spec.start, spec.end)
         self.V = fem.VectorFunctionSpace(m, ("Lagrange", p), dim=9)
         self.w = fem.Function(self.V, name="increments")
-        if spec.axis_quadrature not in ("reduced", "full"):
-            raise ValueError(f"axis_quadrature {spec.axis_quadrature!r}: 'reduced' or 'full'")
         # p + 1 Gauss points (exact to 2p) along s; the axis energy with p points if reduced,
-        # as the Reissner beam integrates its shear and axial energy (model.py, notes §11)
-        self.dx = ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p})
-        q_axis = 2 * p - 1 if spec.axis_quadrature == "reduced" else 2 * p
-        self.dx_axis = ufl.dx(domain=m, metadata={"quadrature_degree": q_axis})
-        self.ds = ufl.ds(domain=m, subdomain_data=self.mesh.point_tags)
+        # as the Reissner beam integrates its shear and axial energy (notes §11)
+        self.dx = d.dx
+        self.dx_axis = d.dx_shear if spec.axis_quadrature == "reduced" else d.dx
         self.load_factor = fem.Constant(m, PETSc.ScalarType(0.0))
 
         # data as constants: one compiled form per (variant, degree, axis rule, follower)
@@ -101,7 +107,7 @@ class ContinuumBeam:
         self.couple = constant([np.dot(spec.moment, a) for a in self.frame])  # section axes
         self.bcs = []
         if spec.clamped:
-            verts = self.mesh.point_tags.find(self.mesh.points["start"][0])
+            verts = self.mesh.point_tags.find(self.mesh.points["b:start"][0])
             dofs = fem.locate_dofs_topological(self.V, 0, verts)
             self.bcs = [fem.dirichletbc(fem.Function(self.V), dofs)]
         self.F, self.J = self._forms()
@@ -138,7 +144,7 @@ class ContinuumBeam:
         h, w = self.data["h"], self.data["w"]
         work = ufl.dot(self.force, v_r)
         work += forms.end_couple_work(self.couple, h, w, d2, d3, v_d2, v_d3)
-        return work * self.ds(self.mesh.points["end"][0])
+        return work * self.discretisation.point_measure("b:end")[0]
 
     def _forms(self):
         v = ufl.TestFunction(self.V)
@@ -163,7 +169,7 @@ class ContinuumBeam:
         from dolfinx import fem
 
         if not hasattr(self, "_end_forms"):
-            dP = self.ds(self.mesh.points["end"][0])
+            dP = self.discretisation.point_measure("b:end")[0]
             self._end_forms = [compile_form(self.w[i] * dP) for i in range(9)]
         v = np.array([self.comm.allreduce(fem.assemble_scalar(f)) for f in self._end_forms])
         u, a2, a3 = v[:3], v[3:6], v[6:]
