@@ -4,7 +4,8 @@ section fields, reference frames and measures; everything but the unknowns and t
 :func:`discretise` builds it once from a :class:`~beamfx.analyses.spec.Model`. The full and
 planar :class:`~beamfx.analyses.model.BeamModel` and the statically condensed
 :class:`~beamfx.analyses.condensed.CondensedModel` compose one (``model.discretisation``), so a
-scene gives the same mesh, frames and section data whichever formulation solves it.
+scene gives the same mesh, frames and section data whichever formulation solves it. The
+continuum beam (:mod:`beamfx.continuum.solve`) takes its mesh, end points and measures from it.
 
 Section data per cell: the stiffnesses (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertias
 (ρA, ρI_1, ρI_2, ρI_3) are DG_p fields where a section varies along a beam and DG0 otherwise;

@@ -12,9 +12,10 @@ beamfx may use of one (``tests/test_formulation.py`` checks that the analyses us
   rotating and arc-length analyses differentiate: :class:`~beamfx.analyses.model.BeamModel`
   provides it; the condensed model (rotations only, static) does not.
 
-The continuum beam (:mod:`beamfx.continuum`) has its own solves and provides neither: its
-unknowns (centre line and two section vectors) have no rotation field for the probes, section
-writers and the beam analyses to read.
+The continuum beam (:mod:`beamfx.continuum`) builds on the same discretisation (mesh, end
+points, measures) but has its own solves and provides neither protocol: its unknowns (centre
+line and two section vectors) have no rotation field for the probes, section writers and beam
+analyses to read.
 """
 
 from typing import Protocol, runtime_checkable
