@@ -12,29 +12,24 @@ from beamfx.analyses.formulation import BEAM_FORMULATION_MEMBERS, FORMULATION_ME
 
 PACKAGE = Path(__file__).resolve().parents[1] / "beamfx"
 
-#: modules that receive a formulation, and the protocol whose members they may use
+#: analyses modules that define formulations or read only model descriptions
+NOT_USERS = {"model", "condensed", "discretisation", "formulation", "spec", "checks", "trimming"}
+#: modules that receive a formulation, and the protocol whose members they may use: static
+#: solves, the writers and the runner any Formulation (the condensed model too); the other
+#: analyses a BeamFormulation
 FORMULATION_USERS = {
     "analyses/static.py": FORMULATION_MEMBERS,
     "runner.py": FORMULATION_MEMBERS,
     **{f"io/{p.name}": FORMULATION_MEMBERS for p in (PACKAGE / "io").glob("*.py")},
     **{
-        f"analyses/{name}.py": BEAM_FORMULATION_MEMBERS
-        for name in (
-            "modal",
-            "buckling",
-            "transient",
-            "continuation",
-            "rotating",
-            "conserving",
-            "campbell",
-            "dofs",
-            "adaptive",
-        )
+        f"analyses/{p.name}": BEAM_FORMULATION_MEMBERS
+        for p in (PACKAGE / "analyses").glob("*.py")
+        if p.stem not in NOT_USERS | {"static", "__init__"}
     },
-    **{f"analyses/{p.name}": BEAM_FORMULATION_MEMBERS for p in PACKAGE.glob("analyses/*_run.py")},
 }
 #: functions of those modules whose ``model`` is a :class:`~beamfx.analyses.spec.Model`
-SPEC_FUNCTIONS = {"motion_warnings", "with_discretisation"}
+#: (``defaults`` and ``problems_in``: the hooks of an analysis' Settings)
+SPEC_FUNCTIONS = {"motion_warnings", "with_discretisation", "defaults", "problems_in"}
 DISCRETISATION_MEMBERS = {f.name for f in fields(Discretisation)} | {
     name for name in vars(Discretisation) if not name.startswith("_")
 }
