@@ -16,11 +16,11 @@ import numpy as np
 from mpi4py import MPI
 
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointLoad, Support
 from beamfx.analyses.static import solve_static
 from beamfx.geometry import Line
 from beamfx.io import evaluate_points, log, track_rotations
 from beamfx.physics.sections import Section
+from beamfx.spec import Beam, Model, PointLoad, Support
 
 # ## The model
 # The section of the Kynema roll-up test ($L = 10$, $EI_y = 86.9\cdot10^3$); 16 cubic elements.

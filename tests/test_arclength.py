@@ -31,9 +31,9 @@ P3_NE10_RTOL = 1e-4
 
 
 def lee_frame(elements, degree):
-    from beamfx.analyses.spec import Beam, Model, PointLoad, Support
     from beamfx.geometry import Line
     from beamfx.physics.sections import Section
+    from beamfx.spec import Beam, Model, PointLoad, Support
 
     # planar frame in x-y; the out-of-plane stiffness only has to be positive: square section,
     # shear about 100 times stiffer than stretching (shear rigid for this slenderness, L/h = 60)

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, Support
 from beamfx.bench._builders import CLAMP, cantilever, straight
 from beamfx.io.probes import evaluate_points
 from beamfx.physics import sections
 from beamfx.physics.kinematics import Kinematics
+from beamfx.spec import Beam, Model, Support
 
 
 @pytest.fixture

@@ -7,10 +7,10 @@ import pytest
 
 from beamfx.analyses.condensed import CondensedModel, RotationRangeError, condensed_fit
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import PointLoad
 from beamfx.analyses.static import solve_static
 from beamfx.bench.howcroft_2016 import _build
 from beamfx.io import evaluate_points
+from beamfx.spec import PointLoad
 
 POINTS = ["b:end", "b:0.5"]
 

@@ -8,13 +8,13 @@ import pytest
 from test_transient import CLAMP, RHO, E, G, flying_spaghetti, hat
 
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointLoad, PointMass, Support
 from beamfx.analyses.static import solve_static
 from beamfx.analyses.transient import TransientSettings, solve_transient
 from beamfx.geometry import Line
 from beamfx.physics.kinematics import Kinematics
 from beamfx.physics.sections import Section, tube
 from beamfx.solvers.integrators import generalized_alpha
+from beamfx.spec import Beam, Model, PointLoad, PointMass, Support
 
 
 def free_flight(spec, t_end, dt=0.05):

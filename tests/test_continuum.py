@@ -132,11 +132,11 @@ def test_free_free_bending_matches_the_reissner_beam():
     """
     from beamfx.analyses.modal import assemble_pair, free_shift, solve_modes
     from beamfx.analyses.model import BeamModel
-    from beamfx.analyses.spec import Beam, Model
     from beamfx.bench import schwab_meijaard_eigen as se
     from beamfx.bench._builders import straight
     from beamfx.solvers.eigen import solve_eigen
     from beamfx.solvers.forms import compile_form
+    from beamfx.spec import Beam, Model
 
     target = se.THEORY_28["omega_B1"]
     reissner = BeamModel(Model(beams=(Beam("b", straight(1.0), se.S28, 8, 3),)))

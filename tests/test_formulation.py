@@ -9,12 +9,12 @@ from beamfx.analyses.condensed import CondensedModel
 from beamfx.analyses.discretisation import discretise
 from beamfx.analyses.formulation import BeamFormulation, Formulation
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointLoad, Support
 from beamfx.bench._builders import CLAMP, FULL, cantilever, straight
 from beamfx.geometry import Arc, Line
 from beamfx.geometry.frames import default_reference, frame_from_tangent, section_axes_at
 from beamfx.physics import sections
 from beamfx.physics.kinematics import Kinematics
+from beamfx.spec import Beam, Model, PointLoad, Support
 
 SECTION = sections.rectangle(210e9, 80e9, 7850.0, 0.05, 0.03, nu=0.3)
 

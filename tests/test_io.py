@@ -20,7 +20,6 @@ import pytest
 from mpi4py import MPI
 
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointLoad, Support
 from beamfx.analyses.static import solve_static
 from beamfx.geometry import Line
 from beamfx.io import (
@@ -39,6 +38,7 @@ from beamfx.io._sections import rotation_matrices
 from beamfx.physics.kinematics import Kinematics
 from beamfx.physics.rotations import np_quaternion, np_rotation
 from beamfx.physics.sections import Section
+from beamfx.spec import Beam, Model, PointLoad, Support
 
 comm = MPI.COMM_WORLD
 L, EI = 10.0, 215e3

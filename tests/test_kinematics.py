@@ -7,12 +7,12 @@ from conftest import nodal, value_at
 from mpi4py import MPI
 
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointLoad, Support
 from beamfx.analyses.static import solve_static
 from beamfx.geometry import Arc, Line
 from beamfx.physics.rotations import np_quaternion, np_rotation
 from beamfx.physics.sections import Section
 from beamfx.solvers import compile_form
+from beamfx.spec import Beam, Model, PointLoad, Support
 
 CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")
 SEC = Section(EA=1770e3, GA_y=1770e3, GA_z=1770e3, GJ=8.16e3, EI_y=86.9e3, EI_z=215e3)

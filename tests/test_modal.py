@@ -6,11 +6,11 @@ import pytest
 from beamfx.analyses.buckling import solve_buckling
 from beamfx.analyses.modal import solve_modes
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, Support
 from beamfx.analyses.static import solve_static
 from beamfx.bench import schwab_meijaard_eigen as sme
 from beamfx.bench._builders import CLAMP, cantilever, straight
 from beamfx.physics.kinematics import Kinematics
+from beamfx.spec import Beam, Model, Support
 
 RIGID = Kinematics(shear=False)  # Euler-Bernoulli limit: penalty 1e8 EI/L^2, error ~3e-8
 S = sme.S29  # square steel 20 x 20 mm

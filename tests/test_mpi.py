@@ -139,11 +139,11 @@ def load_scene_data():
 def test_solid_matches_serial(solver):
     """The 3D solid of SM 2.1 (2 x 4 x 25 Q2 hexahedra) from 1 and 2 ranks: MUMPS, and CG +
     GAMG (whose preconditioner depends on the partition, converged to rtol 1e-10)."""
-    from beamfx.analyses.spec import Beam
     from beamfx.bench import schwab_meijaard_2009 as sm
     from beamfx.bench._builders import straight
     from beamfx.solid.geometry import SolidMesh
     from beamfx.solid.solve import Solid, SolidSpec
+    from beamfx.spec import Beam
 
     beam = Beam("b", straight(1.0), sm.S21, 1)
     loads = {"end": ((0, 0, sm.F), (sm.MX, sm.MY, 0))}

@@ -10,7 +10,6 @@ from scipy.optimize import brentq
 
 from beamfx.analyses.modal import solve_modes
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointMass, Support
 from beamfx.analyses.static import solve_static
 from beamfx.bench._builders import CLAMP, straight
 from beamfx.physics import sections
@@ -18,6 +17,7 @@ from beamfx.physics.inertia import point_kinetic_energy, point_mass_form
 from beamfx.physics.kinematics import Kinematics, displacement, spatial_virtual_rotation
 from beamfx.scene import SceneError
 from beamfx.scene.load import parse_scene
+from beamfx.spec import Beam, Model, PointMass, Support
 
 E, NU = 210e9, 0.3
 G = E / (2 * (1 + NU))

@@ -20,13 +20,13 @@ from beamfx.analyses.rotating import (
     solve_rotating_modes,
     solve_steady,
 )
-from beamfx.analyses.spec import Beam, Model, Support
 from beamfx.bench import schwab_meijaard_rotating as smr
 from beamfx.bench._builders import CLAMP, straight
 from beamfx.physics import sections
 from beamfx.physics.kinematics import Kinematics
 from beamfx.runner import run_scene
 from beamfx.solvers.snes import SolveFailed
+from beamfx.spec import Beam, Model, Support
 
 E, RHO = smr.E, smr.RHO
 GAUSS_X, GAUSS_W = np.polynomial.legendre.leggauss(60)

@@ -8,13 +8,13 @@ import pytest
 
 pytest.importorskip("gmsh")
 
-from beamfx.analyses.spec import Beam
 from beamfx.bench import schwab_meijaard_2009 as sm
 from beamfx.bench._builders import straight
 from beamfx.geometry import Arc
 from beamfx.physics import sections
 from beamfx.scene import SceneError
 from beamfx.solid.geometry import SolidMesh, SweepError, check_sweep
+from beamfx.spec import Beam
 
 SCENE = """
 [material]
@@ -203,8 +203,8 @@ def test_turned_section_is_the_unturned_one_turned():
 def test_section_turning_against_an_arc_is_refused():
     """An arc whose orientation vector is neither its axis nor in its plane: the beam's section
     turns against the arc, the revolved solid's would not. Named, not built."""
-    from beamfx.analyses.spec import Beam
     from beamfx.solid.geometry import frame_turn_deg
+    from beamfx.spec import Beam
 
     arc = Arc((0, 0, 0), (1, 0, 0), (0, 1, 0), 90)
     section = sections.rectangle(2e11, 8e10, 0.0, 0.2, 0.1)

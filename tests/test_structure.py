@@ -27,7 +27,7 @@ FORMULATION_USERS = {
         if p.stem not in NOT_USERS | {"static", "__init__"}
     },
 }
-#: functions of those modules whose ``model`` is a :class:`~beamfx.analyses.spec.Model`
+#: functions of those modules whose ``model`` is a :class:`~beamfx.spec.Model`
 #: (``defaults`` and ``problems_in``: the hooks of an analysis' Settings)
 SPEC_FUNCTIONS = {"motion_warnings", "with_discretisation", "defaults", "problems_in"}
 DISCRETISATION_MEMBERS = {f.name for f in fields(Discretisation)} | {

@@ -13,10 +13,10 @@ from mpi4py import MPI
 
 from beamfx.analyses.buckling import solve_buckling
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import PointLoad
 from beamfx.analyses.static import solve_static
 from beamfx.bench import reference
 from beamfx.bench import schwab_meijaard_torque as smt
+from beamfx.spec import PointLoad
 
 M_TH = smt.M_TH_27
 

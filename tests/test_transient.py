@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.spec import Beam, Model, PointLoad, Support
 from beamfx.analyses.static import solve_static
 from beamfx.analyses.transient import TransientFailed, TransientSettings, solve_transient
 from beamfx.analyses.transient_run import motion_warnings
@@ -17,6 +16,7 @@ from beamfx.physics.kinematics import Kinematics
 from beamfx.physics.sections import tube
 from beamfx.scene import SceneError
 from beamfx.scene.load import parse_scene
+from beamfx.spec import Beam, Model, PointLoad, Support
 
 E, G, RHO = 210e9, 80.77e9, 7850.0
 CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")
@@ -262,7 +262,7 @@ def test_flying_spaghetti_keeps_its_momentum(rho_inf):
 def test_tip_mass_swings_at_its_frequency():
     """A heavy tip mass on a light cantilever, released from a small static deflection:
     the tip oscillates at ω = sqrt(3EI/(m L³)) (beam mass 1e-4 of m shifts it by ~1e-5)."""
-    from beamfx.analyses.spec import PointMass
+    from beamfx.spec import PointMass
 
     section = replace(tube(E, G, RHO, 0.02), rho_A=1e-4, rho_I=(1e-10, 1e-10, 1e-10))
     beam = Beam("b", Line((0, 0, 0), (1.0, 0, 0)), section, 4, 3)

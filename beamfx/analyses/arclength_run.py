@@ -4,10 +4,10 @@ through limit points, written to ``path.csv`` as it goes, its limit points in th
 from dataclasses import dataclass
 
 from ..settings import option
+from ..spec import DOF_NAMES
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
-from .spec import DOF_NAMES
 
 
 def _limit(value, fail):
@@ -44,7 +44,7 @@ class Settings:
 
     def problems_in(self, model):
         """The control point must be a point of the model."""
-        from .spec import resolve_point
+        from ..spec import resolve_point
 
         if self.control_point is not None:
             try:

@@ -3,8 +3,8 @@
 import numpy as np
 
 from ..geometry.frames import section_axes_at
+from ..spec import DOF_NAMES, resolve_point
 from .dofs import OUT_OF_PLANE
-from .spec import DOF_NAMES, resolve_point
 
 
 def rigid_mode_rows(xyz, dofs, centre):

@@ -26,9 +26,9 @@ from mpi4py import MPI
 
 from ..physics import condensed as rod
 from ..physics.rotations import np_exp_rotation
+from ..spec import DOF_NAMES, resolve_point
 from .discretisation import Discretised, discretise
 from .dofs import constrained_dofs, global_size, owned_size
-from .spec import DOF_NAMES, resolve_point
 
 #: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
 MAX_ANGLE = np.radians(330.0)
@@ -162,7 +162,7 @@ class FollowerCoupling:
 
 
 class CondensedModel(Discretised):
-    """The statically condensed beam of a :class:`~beamfx.analyses.spec.Model` (see the module
+    """The statically condensed beam of a :class:`~beamfx.spec.Model` (see the module
     doc): a :class:`~beamfx.analyses.formulation.Formulation` whose unknown ``w`` is the
     rotation vector field g on ``W`` (P_k, 3 components), plus ``u`` (the displacement, derived
     by :meth:`sync`) and ``coupling`` (the follower forces' tangent terms, or None).

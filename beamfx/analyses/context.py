@@ -19,7 +19,7 @@ class RunContext:
         frames: the ParaView series: ``want(step, time, last)``, ``write(step, time)``,
             ``resume(t_max)``, ``files()``.
         probes: ``{probe name: point name}`` of the scene.
-        spec: the model description (:class:`~beamfx.analyses.spec.Model`).
+        spec: the model description (:class:`~beamfx.spec.Model`).
         file: the scene file, for messages.
         solver_options: the scene's ``[solver]`` PETSc options.
         restart: a transient goes on from its last checkpoint in ``folder``.

@@ -13,8 +13,8 @@ import numpy as np
 
 from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
+from ..spec import DOF_NAMES
 from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
-from .spec import DOF_NAMES
 
 
 class PathPoint(NamedTuple):

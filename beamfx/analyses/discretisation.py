@@ -1,7 +1,7 @@
 """The discretisation of a beam model that every formulation shares: mesh, named points,
 section fields, reference frames and measures; everything but the unknowns and the energy.
 
-:func:`discretise` builds it once from a :class:`~beamfx.analyses.spec.Model`. The full and
+:func:`discretise` builds it once from a :class:`~beamfx.spec.Model`. The full and
 planar :class:`~beamfx.analyses.model.BeamModel` and the statically condensed
 :class:`~beamfx.analyses.condensed.CondensedModel` compose one (``model.discretisation``), so a
 scene gives the same mesh, frames and section data whichever formulation solves it. The
@@ -23,8 +23,8 @@ from mpi4py import MPI
 from ..geometry import BeamSpec, build_mesh
 from ..geometry.frames import default_reference
 from ..physics.kinematics import section_frame, tangent
+from ..spec import resolve_point
 from .checks import joint_breaks
-from .spec import resolve_point
 
 
 def cell_field(mesh, degree, values):
@@ -134,7 +134,7 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
     """The :class:`Discretisation` of the model ``spec``. Collective.
 
     Args:
-        spec: :class:`~beamfx.analyses.spec.Model`; its kinematics' ``shear`` and ``stretch``
+        spec: :class:`~beamfx.spec.Model`; its kinematics' ``shear`` and ``stretch``
             decide the section limits (the other kinematic options do not enter).
         comm: MPI communicator.
         extra_points: names (``beam:where``) that must be mesh vertices too (probes).
@@ -181,7 +181,7 @@ class Discretisation:
     and Λ0 maps section axes to global ones (columns t0, e2, e3).
     """
 
-    spec: object  #: the :class:`~beamfx.analyses.spec.Model` discretised
+    spec: object  #: the :class:`~beamfx.spec.Model` discretised
     comm: object  #: MPI communicator
     mesh: object  #: :class:`~beamfx.geometry.BeamMesh` (P_degree geometry, named point tags)
     degree: int  #: polynomial degree of the geometry and of every field on it

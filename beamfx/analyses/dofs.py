@@ -9,7 +9,7 @@ ghosts, so a reduction over ranks counts a dof once when it looks at owned entri
 import numpy as np
 from mpi4py import MPI
 
-from .spec import DOF_NAMES
+from ..spec import DOF_NAMES
 
 #: dofs that the planar model does not have, per plane
 OUT_OF_PLANE = {"xy": ("uz", "rx", "ry"), "yz": ("ux", "ry", "rz"), "xz": ("uy", "rx", "rz")}

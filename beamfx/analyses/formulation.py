@@ -1,6 +1,6 @@
 """What a formulation provides to the analyses, the solvers' glue and the writers.
 
-A formulation turns a :class:`~beamfx.analyses.spec.Model` into unknowns and forms on a shared
+A formulation turns a :class:`~beamfx.spec.Model` into unknowns and forms on a shared
 :class:`~beamfx.analyses.discretisation.Discretisation`. Two protocols name what the rest of
 beamfx may use of one (``tests/test_formulation.py`` checks that the analyses use nothing else):
 
@@ -26,7 +26,7 @@ class Formulation(Protocol):
     """A discretised beam formulation: unknowns, residual, tangent, supports and output."""
 
     spec: object
-    """The :class:`~beamfx.analyses.spec.Model` it discretises."""
+    """The :class:`~beamfx.spec.Model` it discretises."""
     kin: object
     """Its :class:`~beamfx.physics.kinematics.Kinematics` (finite or linear, planar or not,
     shear, stretch)."""

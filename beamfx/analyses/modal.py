@@ -142,8 +142,8 @@ def effective_masses(model, modes, rotary="full"):
     """
     import dolfinx.fem.petsc as fp
 
+    from ..spec import DOF_NAMES
     from .dofs import displacement_components, owned_size, subspace_dofs
-    from .spec import DOF_NAMES
 
     M = fp.assemble_matrix(compile_form(mass_ufl(model, rotary)), bcs=model.bcs, diagonal=0.0)
     M.assemble()

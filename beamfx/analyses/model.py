@@ -13,14 +13,14 @@ from mpi4py import MPI
 from ..physics import energy
 from ..physics.kinematics import displacement, rotation_output, rotation_vector, strains
 from ..physics.rotations import np_quaternion
+from ..spec import DOF_NAMES
 from .checks import check_planar
 from .discretisation import Discretised, discretise
 from .dofs import global_size, subspace_dofs
-from .spec import DOF_NAMES
 
 
 class BeamModel(Discretised):
-    """The discrete Simo–Reissner model of a :class:`~beamfx.analyses.spec.Model`: a
+    """The discrete Simo–Reissner model of a :class:`~beamfx.spec.Model`: a
     :class:`~beamfx.analyses.formulation.BeamFormulation`.
 
     Unknowns: displacement P_k (3, or 2 in a plane) and rotation P_k (quaternion 4, rotation

@@ -39,7 +39,7 @@ class Settings:
 
     def problems_in(self, model):
         """The hub must be a point of the model."""
-        from .spec import resolve_point
+        from ..spec import resolve_point
 
         try:
             resolve_point(model, self.hub)
@@ -98,9 +98,9 @@ def _branches(result):
 
 def run(model, settings, ctx):
     """Steady state and frequencies at every speed; the Campbell files in the output folder."""
+    from ..spec import resolve_point
     from .campbell import campbell, write_campbell
     from .rotating import RotatingFrame
-    from .spec import resolve_point
 
     _check_mass(model, ctx)
     hub = resolve_point(ctx.spec, settings.hub)[2]

@@ -31,8 +31,8 @@ import numpy as np
 
 from ..geometry.frames import section_axes_at
 from ..physics.kinematics import PLANES
+from ..spec import DOF_NAMES
 from .checks import free_rigid_modes, model_size
-from .spec import DOF_NAMES
 
 #: analyses whose answer includes out-of-plane motion of a plane structure
 NEVER_TRIMMED = ("modal", "buckling", "rotating")
@@ -93,7 +93,7 @@ def _loads(model, n):
 
 
 def _supports(model, n):
-    from .spec import resolve_point
+    from ..spec import resolve_point
 
     off = [i for i in range(3) if i != n]
     for i, sup in enumerate(model.supports):
@@ -138,7 +138,7 @@ def plane_fit(model, plane, settings=None):
 
 
 def choose_plane(model, analysis, settings=None):
-    """The plane in which ``model`` (a full 3D :class:`~beamfx.analyses.spec.Model`) is a plane
+    """The plane in which ``model`` (a full 3D :class:`~beamfx.spec.Model`) is a plane
     problem for ``analysis``, as a :class:`Trim`; ``plane`` None where it is not (or where the
     analysis needs out-of-plane motion, :data:`NEVER_TRIMMED`)."""
     if analysis in NEVER_TRIMMED:

@@ -1,8 +1,8 @@
 """Small model builders shared by the benchmark modules."""
 
-from ..analyses.spec import Beam, Model, PointLoad, Support
 from ..geometry import Arc, Line
 from ..physics.kinematics import Kinematics
+from ..spec import Beam, Model, PointLoad, Support
 
 FULL = Kinematics()
 CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")

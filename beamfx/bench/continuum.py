@@ -257,7 +257,7 @@ def sm28(elements=(4, 8, 16)):
     and classified by its kinetic energy (axial, torsion, bending, section)."""
     from ..analyses.modal import solve_modes
     from ..analyses.model import BeamModel
-    from ..analyses.spec import Beam, Model
+    from ..spec import Beam, Model
 
     T = se.THEORY_28
     ref = {k: SOLID["sm28"][-1][k] for k in T}

@@ -22,10 +22,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..analyses.spec import Beam, Model, Support
 from ..geometry import Line
 from ..physics.kinematics import Kinematics
 from ..physics.sections import Section
+from ..spec import Beam, Model, Support
 from . import Case, reference, register
 from ._builders import CLAMP
 

@@ -15,9 +15,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..analyses.spec import Beam, Model, PointLoad, Support
 from ..physics import sections
 from ..physics.kinematics import Kinematics
+from ..spec import Beam, Model, PointLoad, Support
 from . import Case, reference, register
 from ._builders import cantilever, straight
 

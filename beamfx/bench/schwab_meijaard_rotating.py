@@ -30,9 +30,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..analyses.spec import Beam, Model, Support
 from ..physics import sections
 from ..physics.kinematics import Kinematics
+from ..spec import Beam, Model, Support
 from . import reference, register
 from ._builders import CLAMP, straight
 from .schwab_meijaard_eigen import EigenCase

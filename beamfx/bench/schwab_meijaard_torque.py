@@ -27,8 +27,8 @@ solve_buckling`); at M_cr it is ML/GJ = π(1 + ν) ≈ 4.1 rad for this shaft.
 
 import numpy as np
 
-from ..analyses.spec import Beam, Model, PointLoad, Support
 from ..physics import sections
+from ..spec import Beam, Model, PointLoad, Support
 from . import reference, register
 from ._builders import CLAMP, straight
 from .schwab_meijaard_eigen import FILE, NU, RHO, SETTINGS, E, EigenCase, G, _buckling, _same

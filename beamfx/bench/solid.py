@@ -11,10 +11,10 @@ import sys
 import time
 from pathlib import Path
 
-from ..analyses.spec import Beam, Model
 from ..physics import sections
 from ..physics.kinematics import Kinematics
 from ..solid.geometry import SolidMesh
+from ..spec import Beam, Model
 from . import howcroft_2016 as hc
 from . import schwab_meijaard_2009 as sm
 from . import schwab_meijaard_eigen as se

@@ -14,7 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..analyses.spec import Beam
+from ..spec import Beam
 from . import schwab_meijaard_2009 as sm
 from ._builders import straight
 

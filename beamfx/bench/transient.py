@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analyses.spec import Beam, Model, PointLoad, Support
 from ..geometry import Line
 from ..physics.kinematics import Kinematics
 from ..physics.sections import Section
+from ..spec import Beam, Model, PointLoad, Support
 from . import Case, reference, register
 from ._builders import CLAMP, arc
 

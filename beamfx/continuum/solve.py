@@ -13,12 +13,12 @@ import numpy as np
 import ufl
 
 from ..analyses.discretisation import discretise
-from ..analyses.spec import Beam, Model
 from ..geometry import Line
 from ..geometry.frames import frame_from_tangent
 from ..physics.kinematics import d_ds
 from ..physics.sections import rectangle
 from ..solvers.forms import compile_form
+from ..spec import Beam, Model
 from . import model as forms
 
 KINDS = ("axial", "bending", "torsion", "section")
@@ -54,7 +54,7 @@ class ContinuumSpec:
 
 
 def beam_model(spec):
-    """The :class:`~beamfx.analyses.spec.Model` of the same beam for the shared
+    """The :class:`~beamfx.spec.Model` of the same beam for the shared
     discretisation (:func:`~beamfx.analyses.discretisation.discretise`): one beam "b" along
     the line with the rectangle's section and the spec's elements and degree."""
     line = Line(tuple(spec.start), tuple(spec.end))

@@ -1,4 +1,4 @@
-"""Read a TOML scene into a :class:`~beamfx.analyses.spec.Model` plus analysis settings.
+"""Read a TOML scene into a :class:`~beamfx.spec.Model` plus analysis settings.
 
 The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, ``GA_y``,
 ``EI_y``, ``angle_deg``, ``start_tangent``, ...). See docs/scenes.md for every key.
@@ -12,7 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analyses.spec import (
+from ..analyses.trimming import PLANE_CHOICES
+from ..geometry import curves
+from ..physics import sections
+from ..physics.kinematics import PLANES, Kinematics
+from ..spec import (
     AXES,
     DOF_NAMES,
     LOAD_KINDS,
@@ -24,10 +28,6 @@ from ..analyses.spec import (
     Spring,
     Support,
 )
-from ..analyses.trimming import PLANE_CHOICES
-from ..geometry import curves
-from ..physics import sections
-from ..physics.kinematics import PLANES, Kinematics
 from .expr import compile_expression, table_function
 from .table import SceneError, Table
 
@@ -574,7 +574,7 @@ def _check_model(model, file):
 
 
 def _check_points(model, probes, file):
-    from ..analyses.spec import resolve_point
+    from ..spec import resolve_point
 
     named = [(f"supports[{i}].at", s.at) for i, s in enumerate(model.supports)]
     named += [(f"loads.at ({p.at})", p.at) for p in model.point_loads]
