@@ -14,10 +14,11 @@ n depends on the rotation there. The residual takes F as a constant set from the
 before each assembly; the tangent adds the missing rank-3 term −λ G (∂F/∂g_a) with
 G_i = ∂/∂g ∫₀^{s_a} e_i·x' ds (:class:`FollowerCoupling`), so Newton converges quadratically.
 
-Output: the object is a :class:`~beamfx.analyses.formulation.Formulation`, so the probes and
-field writers read it like the full model (:meth:`section_parts`, :meth:`sync`). The displacement is integrated from x' = R(t0 + Λ0 Γ)
-cell by cell (:meth:`sync`, exact to quadrature); the section force is the statically
-determined one, in section axes Λ0ᵀRᵀn.
+Output: the object is a :class:`~beamfx.analyses.formulation.Formulation` on the shared
+:class:`~beamfx.analyses.discretisation.Discretisation`, so the probes and field writers read
+it like the full model (:meth:`section_parts`). The displacement is integrated from
+x' = R(t0 + Λ0 Γ) cell by cell (:meth:`sync`, exact to quadrature); the section force is the
+statically determined one, in section axes Λ0ᵀRᵀn.
 """
 
 import numpy as np
@@ -29,6 +30,7 @@ from ..physics.rotations import np_exp_rotation
 from ..spec import DOF_NAMES, resolve_point
 from .discretisation import Discretised, discretise
 from .dofs import constrained_dofs, global_size, owned_size
+from .model import BeamModel
 
 #: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
 MAX_ANGLE = np.radians(330.0)
@@ -75,8 +77,6 @@ def condensed_fit(model, analysis="static"):
 def build_model(model, comm, extra_points=(), condense=False):
     """The :class:`CondensedModel` of ``model`` if ``condense``, else its
     :class:`~beamfx.analyses.model.BeamModel`."""
-    from .model import BeamModel
-
     return (CondensedModel if condense else BeamModel)(model, comm, extra_points=extra_points)
 
 
