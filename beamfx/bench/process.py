@@ -3,7 +3,7 @@ user waits for the command (interpreter start, imports, model, solve, output).
 
     python -m beamfx.bench.process <case id> <elements> <degree> <output folder>
 
-The scene is built in code by the case (:func:`beamfx.bench.run.case_scene`) and then run by
+The scene is built in code by the case (:func:`beamfx.bench.scenes.case_scene`) and then run by
 :func:`beamfx.runner.run_scene`, the call behind ``beamfx run``.
 """
 
@@ -24,7 +24,7 @@ def main(argv):
     case_id, elements, degree, folder = argv
     from ..runner import run_scene
     from . import all_cases
-    from .run import case_scene
+    from .scenes import case_scene
 
     scene = case_scene(all_cases()[case_id], int(elements), int(degree))
     run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)

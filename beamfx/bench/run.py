@@ -1,8 +1,6 @@
 """Run benchmark cases and write the JSON and markdown report."""
 
 import json
-import time
-from dataclasses import fields
 from itertools import pairwise
 from pathlib import Path
 
@@ -28,30 +26,6 @@ def newton_seconds(seconds):
     return seconds["assemble_F"] + seconds["assemble_J"] + seconds["solve"]
 
 
-def case_scene(case, elements, degree, analysis="static", **settings):
-    """The scene of one setting of a case, as ``beamfx run`` takes it (built in code)."""
-    from ..analyses.registry import analysis as lookup
-    from ..scene.load import Scene
-
-    spec, steps = case.build(elements, degree)
-    entry = lookup(analysis)
-    if "steps" in {f.name for f in fields(entry.settings)}:
-        settings.setdefault("steps", steps)
-    return Scene(
-        f"bench:{case.id}", spec, analysis, dict(case.probes), settings=entry.settings(**settings)
-    )
-
-
-def run_in_process(scene, folder):
-    """``beamfx run`` of ``scene`` in this process (output written to ``folder``), quiet;
-    returns the :class:`~beamfx.runner.RunResult` and the whole run's wall time."""
-    from ..runner import run_scene
-
-    t0 = time.perf_counter()
-    run = run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)
-    return run, time.perf_counter() - t0
-
-
 def run_setting(case, elements, degree):
     """One setting through ``beamfx run``'s path, twice: cold (first in this process: JIT or
     cache load included) and warm (again: forms compiled); both write the output a user's
@@ -61,6 +35,7 @@ def run_setting(case, elements, degree):
     from ..analyses.model import BeamModel
     from ..solvers.forms import compile_seconds
     from .profiling import jit_seconds
+    from .scenes import case_scene, run_in_process
 
     scene = case_scene(case, elements, degree)
     with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
@@ -235,8 +210,10 @@ def markdown(results, figures=None, note=None):
             "",
         ]
     lines += [
-        ("| case | passed | cheapest within tolerance | error | unknowns | whole run s | "
-        "process s | solve only s |"),
+        (
+            "| case | passed | cheapest within tolerance | error | unknowns | whole run s | "
+            "process s | solve only s |"
+        ),
         "|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
