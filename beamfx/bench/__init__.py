@@ -5,58 +5,9 @@ unknowns, elements × degree, Newton iterations, wall time cold (first JIT) and 
 error against the reference.
 """
 
-import json
-from dataclasses import dataclass, field
-from pathlib import Path
+from .registry import HERE, REGISTRY, Case, reference, register
 
-HERE = Path(__file__).parent
-
-
-def reference(file, case_id=None):
-    """A reference file of this package (copies of the project's shared references)."""
-    data = json.loads((HERE / file).read_text())
-    if case_id is None:
-        return data
-    items = data.get("problems") or data.get("cases")
-    for item in items:
-        if item["id"] == case_id:
-            return item
-    raise KeyError(f"{file}: no case {case_id!r}")
-
-
-@dataclass(frozen=True)
-class Case:
-    """A benchmark case.
-
-    ``build(elements, degree)`` returns ``(Model, steps)``; ``measure(values)`` turns the probe
-    values at the named points (dict from :func:`beamfx.io.probes.evaluate_points`) into named
-    quantities; ``reference`` holds the same names (None where the reference is withheld: the
-    finest setting is then the reference, and the report says so). ``error`` is the relative
-    error norm used against ``tolerance``.
-    """
-
-    id: str
-    paper: str
-    title: str
-    build: object
-    measure: object
-    reference: dict | None
-    tolerance: float
-    settings: tuple  # (elements, degree) pairs, coarse to fine
-    probes: dict = field(default_factory=lambda: {"tip": "b:end"})
-    scale: float | None = None  # error = max |value - ref| / scale (None: relative per value)
-    note: str = ""
-    extra: dict = field(default_factory=dict)
-
-
-REGISTRY: dict[str, Case] = {}
-
-
-def register(case):
-    if case.id in REGISTRY:
-        raise ValueError(f"duplicate benchmark case {case.id}")
-    REGISTRY[case.id] = case
-    return case
+__all__ = ["HERE", "REGISTRY", "Case", "all_cases", "reference", "register"]
 
 
 def all_cases():

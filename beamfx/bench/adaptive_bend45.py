@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import Case, register
 from .howcroft_2016 import _build, _measure
+from .registry import Case, register
 
 MM = 1.0 / 25.4  # the lengths are inches
 _reference = {}

@@ -4,8 +4,8 @@ import numpy as np
 
 from ..geometry import Line
 from ..physics.sections import Section
-from . import Case, reference, register
 from ._builders import cantilever, straight
+from .registry import Case, reference, register
 
 ROLL = reference("classic_cases.json", "ROLLUP")
 L = 10.0

@@ -3,8 +3,8 @@
 import numpy as np
 
 from ..physics import sections
-from . import Case, reference, register
 from ._builders import arc, cantilever
+from .registry import Case, reference, register
 
 FILE = "howcroft_2016.json"
 V = reference(FILE, "bend45_vertical")

@@ -26,8 +26,8 @@ from ..geometry import Line
 from ..physics.kinematics import Kinematics
 from ..physics.sections import Section
 from ..spec import Beam, Model, Support
-from . import Case, reference, register
 from ._builders import CLAMP
+from .registry import Case, reference, register
 
 PAI = reference("howcroft_2016.json", "pai_beam")
 

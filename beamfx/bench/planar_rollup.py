@@ -12,8 +12,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..physics.kinematics import Kinematics
-from . import Case, register
 from .classic import L, _position, _rollup
+from .registry import Case, register
 
 
 def _solve(spec, steps):

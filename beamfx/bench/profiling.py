@@ -14,6 +14,14 @@ import time
 _cold = {}  # case id -> seconds of the cold compile of its first setting
 
 
+def per_iteration(seconds, iterations):
+    """Seconds per Newton iteration of a solve: assembly, LU, triangular solves, the rest
+    (Python), from the solve's wall-time split ``seconds``."""
+    its = max(iterations, 1)
+    keys = ("assemble_F", "assemble_J", "factorise", "triangular_solve", "python")
+    return {k: seconds[k] / its for k in keys}
+
+
 def jit_seconds(case_id, model):
     """{"jit_cold_s", "jit_cached_s"} for the residual and tangent of ``model``."""
     import dolfinx.fem

@@ -6,18 +6,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .profiling import per_iteration
+
 
 def _error(case, values, ref):
     diffs = [abs(values[k] - ref[k]) / (case.scale or max(abs(ref[k]), 1e-300)) for k in ref]
     return float(max(diffs))
-
-
-def per_iteration(seconds, iterations):
-    """Seconds per Newton iteration of a solve: assembly, LU, triangular solves, the rest
-    (Python), from the solve's wall-time split ``seconds``."""
-    its = max(iterations, 1)
-    keys = ("assemble_F", "assemble_J", "factorise", "triangular_solve", "python")
-    return {k: seconds[k] / its for k in keys}
 
 
 def newton_seconds(seconds):

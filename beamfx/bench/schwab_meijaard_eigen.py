@@ -18,8 +18,8 @@ import numpy as np
 from ..physics import sections
 from ..physics.kinematics import Kinematics
 from ..spec import Beam, Model, PointLoad, Support
-from . import Case, reference, register
 from ._builders import cantilever, straight
+from .registry import Case, reference, register
 
 FILE = "schwab_meijaard_2009.json"
 MAT = reference(FILE)["material"]

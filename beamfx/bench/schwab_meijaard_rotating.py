@@ -33,8 +33,8 @@ import numpy as np
 from ..physics import sections
 from ..physics.kinematics import Kinematics
 from ..spec import Beam, Model, Support
-from . import reference, register
 from ._builders import CLAMP, straight
+from .registry import reference, register
 from .schwab_meijaard_eigen import EigenCase
 
 FILE = "schwab_meijaard_2009.json"

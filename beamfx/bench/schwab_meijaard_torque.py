@@ -29,8 +29,8 @@ import numpy as np
 
 from ..physics import sections
 from ..spec import Beam, Model, PointLoad, Support
-from . import reference, register
 from ._builders import CLAMP, straight
+from .registry import reference, register
 from .schwab_meijaard_eigen import FILE, NU, RHO, SETTINGS, E, EigenCase, G, _buckling, _same
 
 P27 = reference(FILE, "sm27_torque_buckling")

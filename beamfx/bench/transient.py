@@ -17,8 +17,8 @@ from ..geometry import Line
 from ..physics.kinematics import Kinematics
 from ..physics.sections import Section
 from ..spec import Beam, Model, PointLoad, Support
-from . import Case, reference, register
 from ._builders import CLAMP, arc
+from .registry import Case, reference, register
 
 SPIN = reference("vm258_spin_up.json")
 P = SPIN["properties"]
@@ -80,7 +80,7 @@ class TransientCase(Case):
 
     def run_setting(self, elements, degree, dt):
         from ..solvers.forms import compile_seconds
-        from .run import per_iteration
+        from .profiling import per_iteration
 
         spec, settings = self.build(elements, degree, dt)
         c0, t0 = compile_seconds[0], time.perf_counter()
