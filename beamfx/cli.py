@@ -1,4 +1,5 @@
-"""The ``beamfx`` command: ``run``, ``check``, ``bench``. Each is one library call."""
+"""The ``beamfx`` command: ``run``, ``check``, ``bench``, ``solid``, ``warm``. Each is one library
+call."""
 
 import argparse
 import sys
@@ -37,6 +38,9 @@ def _parser():
     p.add_argument("cases", nargs="*", help="case ids (default: all); see --list")
     p.add_argument("--report", help="folder for bench.json and README.md")
     p.add_argument("--list", action="store_true", help="list the case ids")
+    p = sub.add_parser("warm", help="compile the kernels of common scenes into the JIT cache")
+    p.add_argument("scenes", nargs="*", help="also these: files, folders, .md with toml blocks")
+    p.add_argument("--only", action="store_true", help="only these (not the default and grid)")
     p = sub.add_parser("solid", help="the 3D solid of a one-beam scene, compared with the beam")
     p.add_argument("scene")
     p.add_argument("--out", help="output folder (default: <the scene's [output] dir>/solid)")
@@ -109,7 +113,14 @@ def _bench(args):
     return 0
 
 
-COMMANDS = {"run": _run, "check": _check, "solid": _solid, "bench": _bench}
+def _warm(args):
+    from .warm import warm
+
+    warm(args.scenes, common=not args.only)
+    return 0
+
+
+COMMANDS = {"run": _run, "check": _check, "solid": _solid, "bench": _bench, "warm": _warm}
 
 
 def main(argv=None):
