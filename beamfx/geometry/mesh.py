@@ -10,8 +10,6 @@ from itertools import pairwise
 from typing import NamedTuple
 
 import numpy as np
-import ufl
-from mpi4py import MPI
 
 
 @dataclass(frozen=True)
@@ -90,6 +88,8 @@ def build_mesh(comm, specs, degree, named_points=None):
         :class:`BeamMesh`.
     """
     import dolfinx
+    import ufl
+    from mpi4py import MPI
 
     size = max(np.ptp(np.vstack([s.curve.points([0, s.curve.length]) for s in specs])), 1.0)
     tol = 1e-9 * size

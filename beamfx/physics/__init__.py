@@ -22,4 +22,8 @@ A prime is the derivative along ``s``. Vectors are in global axes unless the doc
 "section axes". The rotation is total Lagrangian and singularity free: the quaternion field
 passes any angle (2π, 4π, ...) without special treatment, and ``R`` and ``K`` do not depend on
 the norm of ``q``; a penalty on :math:`(|q|^2 - 1)^2` only removes that null direction.
+
+Each function imports ``ufl`` itself: the scene layer uses :class:`~.kinematics.Kinematics`
+and the sections, and ``beamfx check`` should not pay for UFL (with pkg_resources) to read a
+file.
 """

@@ -13,8 +13,6 @@ s, so polynomials represent a roll-up well; valid for angles below 2π, where th
 to R is singular (:data:`~beamfx.analyses.condensed.MAX_ANGLE`).
 """
 
-import ufl
-
 from .kinematics import d_ds
 from .rotations import body_rate, rotation, spatial_rate
 
@@ -22,6 +20,8 @@ from .rotations import body_rate, rotation, spatial_rate
 def rotation_quaternion(psi):
     """Unit quaternion (cos(θ/2), sin(θ/2) ψ/θ) of the rotation vector ψ, θ = |ψ|; the Taylor
     series of both factors below θ² = 1e-6 (error O(θ⁶), no 0/0)."""
+    import ufl
+
     tt = ufl.dot(psi, psi)
     theta = ufl.sqrt(tt + 1e-300)
     small = ufl.lt(tt, 1e-6)
@@ -32,6 +32,8 @@ def rotation_quaternion(psi):
 
 def curvature(g, t0, Lam0):
     """K = Λ0ᵀ axial(Rᵀ R') (section axes), as :func:`~beamfx.physics.kinematics.finite_strains`."""
+    import ufl
+
     q = rotation_quaternion(g)
     dq = ufl.as_vector([d_ds(q[i], t0) for i in range(4)])
     return Lam0.T * body_rate(q, dq)
@@ -39,6 +41,8 @@ def curvature(g, t0, Lam0):
 
 def virtual_rotation(g, dg, spatial=True):
     """δθ of a variation ``dg``: axial(δR Rᵀ) (global axes) or axial(Rᵀ δR) (body axes)."""
+    import ufl
+
     q = rotation_quaternion(g)
     dq = ufl.derivative(q, g, dg)
     return spatial_rate(q, dq) if spatial else body_rate(q, dq)
@@ -65,6 +69,8 @@ def load_potential(g, n, t0, Lam0, compliance, dx):
     rotations as the only unknowns (exact, not an approximation: shear and stretch are kept).
     With the compliance zero it is the Kirchhoff rod's −Σ F·u(s_a).
     """
+    import ufl
+
     Gamma = section_strains(g, n, Lam0, compliance)
     R = rotation(rotation_quaternion(g))
     return (ufl.dot(n, (R - ufl.Identity(3)) * t0) + 0.5 * ufl.dot(Gamma, Lam0.T * (R.T * n))) * dx
@@ -72,5 +78,7 @@ def load_potential(g, n, t0, Lam0, compliance, dx):
 
 def bending_energy(g, t0, Lam0, C_M, dx):
     """½ K·C_M K: the whole strain energy of the Kirchhoff rod."""
+    import ufl
+
     K = curvature(g, t0, Lam0)
     return 0.5 * ufl.dot(K, C_M * K) * dx

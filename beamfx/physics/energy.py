@@ -1,7 +1,5 @@
 """Strain energy and the virtual work of loads (notation: package doc)."""
 
-import ufl
-
 from .kinematics import (
     body_virtual_rotation,
     displacement,
@@ -17,16 +15,22 @@ def strain_energy(Gamma, K, C_N, C_M, dx_shear, dx_bend):
     The shear/axial part is integrated with one Gauss point fewer (``dx_shear``, exact to
     degree 2p−1): with full integration the quadratic element locks in thin-beam bending.
     """
+    import ufl
+
     return 0.5 * ufl.dot(Gamma, C_N * Gamma) * dx_shear + 0.5 * ufl.dot(K, C_M * K) * dx_bend
 
 
 def quaternion_penalty(q, k_p, dx):
     r"""½ k_p (|q|² − 1)²: fixes the norm of q, which R(q) and K do not see."""
+    import ufl
+
     return 0.5 * k_p * (ufl.dot(q, q) - 1) ** 2 * dx
 
 
 def force_work(kin, rot, v_u, force, follower):
     """Virtual work of a force (global axes); a follower force is R·force (turns with the section)."""
+    import ufl
+
     f = section_rotation(kin, rot) * force if follower else force
     return ufl.dot(f, displacement(kin, v_u))
 
@@ -47,6 +51,8 @@ def moment_work(kin, rot, v_rot, moment, kind, arm=None):
       with the rotation about the force direction F̂. The two couples with arms â and F̂ have
       the mean potential −M0·ψ + O(ψ³), the semitangential moment.
     """
+    import ufl
+
     if kind == "follower":
         return ufl.dot(moment, body_virtual_rotation(kin, rot, v_rot))
     if kind == "semitangential":
@@ -67,6 +73,8 @@ def moment_work(kin, rot, v_rot, moment, kind, arm=None):
 def _work_of_potential(kin, rot, v_rot, work):
     """δ(work(rot)) in the direction ``v_rot``; the planar model's single angle is
     differentiated as a UFL variable (``ufl.derivative`` needs matching vector shapes)."""
+    import ufl
+
     if kin.plane:
         angle = ufl.variable(rot[0])
         return ufl.diff(work(ufl.as_vector([angle])), angle) * v_rot[0]
@@ -75,6 +83,8 @@ def _work_of_potential(kin, rot, v_rot, work):
 
 def spring_energy(u, k):
     """½ u·diag(k) u of a translational spring to ground (k per global axis)."""
+    import ufl
+
     return 0.5 * ufl.dot(u, ufl.diag(ufl.as_vector(k)) * u)
 
 

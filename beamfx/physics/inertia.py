@@ -17,7 +17,6 @@ reference state) adds T = ½ m u̇·u̇ + ½ ω·R J0 Rᵀ ω there: it turns wi
 """
 
 import numpy as np
-import ufl
 
 from .kinematics import displacement, section_rotation, spatial_virtual_rotation
 
@@ -33,6 +32,8 @@ def section_frame_now(kin, rot, Lam0):
 
 def spatial_inertia(kin, rot, Lam0, rho_I, rotary="full"):
     """Rotary inertia in global axes, Λ diag(ρI) Λᵀ, with the weights of :data:`ROTARY`."""
+    import ufl
+
     c = ROTARY[rotary]
     J = ufl.diag(ufl.as_vector([c[i] * rho_I[i] for i in range(3)]))
     Lam = section_frame_now(kin, rot, Lam0)
@@ -47,6 +48,8 @@ def mass_form(kin, rot, v, dw, inertia, Lam0, dx, rotary="full"):
         inertia: (ρA, ρI_polar, ρI_y, ρI_z) per point, section axes.
         rotary: one of :data:`ROTARY`.
     """
+    import ufl
+
     (v_u, v_rot), (du, drot) = v, dw
     m = inertia[0] * ufl.dot(displacement(kin, du), displacement(kin, v_u))
     if rotary != "none":
@@ -71,6 +74,8 @@ def kinetic_energy(kin, rot, u_dot, rot_dot, inertia, Lam0, rotary="full"):
     quaternion parametrisation (its norm direction carries no kinetic energy: ω does not see
     q̇ ∥ q). ``inertia`` and ``rotary`` as in :func:`mass_form`.
     """
+    import ufl
+
     u3 = displacement(kin, u_dot)
     T = 0.5 * inertia[0] * ufl.dot(u3, u3)
     if rotary != "none":
@@ -90,6 +95,8 @@ def point_inertia(kin, rot, inertia):
     """Rotary inertia of a point mass in global axes, R J0 Rᵀ: ``inertia`` J0 (3x3, or its
     diagonal; global axes in the reference state) turns with the section (J0 itself for the
     linear kinematics)."""
+    import ufl
+
     J0 = ufl.as_matrix(_inertia_matrix(inertia).tolist())
     if not kin.finite:
         return J0
@@ -105,6 +112,8 @@ def point_mass_form(kin, rot, v, dw, mass, inertia):
         v, dw: (displacement, rotation) pairs of the test and trial functions.
         mass: m; inertia: J0 about the point (3x3, global axes in the reference state).
     """
+    import ufl
+
     (v_u, v_rot), (du, drot) = v, dw
     m = float(mass) * ufl.dot(displacement(kin, du), displacement(kin, v_u))
     if np.any(_inertia_matrix(inertia)):
@@ -122,6 +131,8 @@ def point_kinetic_energy(kin, rot, u_dot3, omega, mass, inertia):
         omega: spatial angular velocity ω = axial(Ṙ Rᵀ) (3-vector, global axes).
         mass: m; inertia: J0 about the point (3x3, global axes in the reference state).
     """
+    import ufl
+
     T = 0.5 * float(mass) * ufl.dot(u_dot3, u_dot3)
     if np.any(_inertia_matrix(inertia)):
         T += 0.5 * ufl.dot(omega, point_inertia(kin, rot, inertia) * omega)

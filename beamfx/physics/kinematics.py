@@ -2,8 +2,6 @@
 
 from dataclasses import dataclass
 
-import ufl
-
 from .rotations import body_rate, rotation
 
 
@@ -53,11 +51,15 @@ PLANES = {"xy": (0, 1, 2), "yz": (1, 2, 0), "xz": (2, 0, 1)}
 
 
 def plane_normal(kin):
+    import ufl
+
     return ufl.as_vector([1.0 if i == PLANES[kin.plane][2] else 0.0 for i in range(3)])
 
 
 def displacement(kin, u):
     """The displacement field (or a test function of it) as a 3-vector in global axes."""
+    import ufl
+
     if not kin.plane:
         return u
     a, b, _ = PLANES[kin.plane]
@@ -68,12 +70,16 @@ def displacement(kin, u):
 
 def tangent(mesh):
     """Unit tangent t0 = J/|J| of the (curved, P_k) reference centre line."""
+    import ufl
+
     J = ufl.Jacobian(mesh)[:, 0]
     return J / ufl.sqrt(ufl.dot(J, J))
 
 
 def d_ds(f, t0):
     """Derivative along the centre line: the tangential gradient contracted with t0."""
+    import ufl
+
     return ufl.dot(ufl.grad(f), t0)
 
 
@@ -83,6 +89,8 @@ def section_frame(t0, reference, twist):
     e3 is ``reference`` made normal to t0 (the section's local z, the direction of a rectangle's
     h), e2 = e3 × t0, both then turned by ``twist`` (radians) about t0.
     """
+    import ufl
+
     e3 = reference - ufl.dot(reference, t0) * t0
     e3 = e3 / ufl.sqrt(ufl.dot(e3, e3))
     e2 = ufl.cross(e3, t0)
@@ -101,12 +109,16 @@ def finite_strains(u, q, t0, Lam0):
 
 def linear_strains(u, theta, t0, Lam0):
     r"""Small-rotation limit: Γ = Λ0ᵀ(u' + t0 × θ), K = Λ0ᵀ θ' (linear Timoshenko), section axes."""
+    import ufl
+
     return Lam0.T * (d_ds(u, t0) + ufl.cross(t0, theta)), Lam0.T * d_ds(theta, t0)
 
 
 def planar_strains(kin, u, angle, t0, Lam0):
     r"""Plane model: Γ as in :func:`finite_strains` (or :func:`linear_strains`) with R the
     rotation by ``angle`` about the normal n, and K = Λ0ᵀ n φ' (exact: R n = n)."""
+    import ufl
+
     n = plane_normal(kin)
     u3 = displacement(kin, u)
     if kin.finite:
@@ -141,6 +153,8 @@ def body_virtual_rotation(kin, rot, drot):
 
 def section_rotation(kin, rot):
     """Rotation R taking reference section axes to current ones (identity + hat θ if linear)."""
+    import ufl
+
     from .rotations import hat
 
     if kin.plane:
@@ -162,6 +176,8 @@ def rotation_vector(kin, rot):
 
 def rotation_output(kin, rot):
     """The rotation as post-processing reads it: a quaternion (finite) or θ (linear)."""
+    import ufl
+
     if not kin.plane:
         return rot
     n = plane_normal(kin)

@@ -19,8 +19,6 @@ which splits by powers of the rates into T = T₂ + T₁ + T₀:
 is blind to the norm of q (as is J), so a and G see only the rotation q/|q|.
 """
 
-import ufl
-
 from .rotations import hat
 
 
@@ -31,6 +29,8 @@ def relative_position(X, u, hub):
 
 def centrifugal_potential(rho_A, J, omega, r):
     r"""V_c = −½ ρA |Ω × r|² − ½ Ω·J Ω per unit length; J is the spatial section inertia."""
+    import ufl
+
     return -0.5 * rho_A * ufl.dot(ufl.cross(omega, r), ufl.cross(omega, r)) - 0.5 * ufl.dot(
         omega, J * omega
     )
@@ -43,4 +43,6 @@ def gyroscopic_covector(rho_A, J, omega, r, v_u, v_theta):
     G(δ, Δ) = ∂a/∂q[Δ]·δ − ∂a/∂q[δ]·Δ; for the centre line alone that is
     2 ρA δu·(Ω × Δu), the Coriolis force 2 ρA Ω × u̇.
     """
+    import ufl
+
     return rho_A * ufl.dot(v_u, hat(omega) * r) + ufl.dot(v_theta, J * omega)

@@ -5,21 +5,26 @@ to global (spatial) vectors.
 """
 
 import numpy as np
-import ufl
 
 
 def hat(v):
     """Skew matrix with ``hat(v) @ a = v × a``."""
+    import ufl
+
     return ufl.as_matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
 
 def axial(A):
     """Inverse of :func:`hat` applied to the skew part of ``A``."""
+    import ufl
+
     return ufl.as_vector([A[2, 1] - A[1, 2], A[0, 2] - A[2, 0], A[1, 0] - A[0, 1]]) / 2
 
 
 def quaternion_vector(q):
     """Vector part of the quaternion ``q``."""
+    import ufl
+
     return ufl.as_vector([q[1], q[2], q[3]])
 
 
@@ -30,6 +35,8 @@ def rotation(q):
     (e.g. Géradin & Cardona 2001, eq. 4.53, divided by the norm so that it is a rotation for
     every non-zero ``q``).
     """
+    import ufl
+
     v = quaternion_vector(q)
     q0 = q[0]
     return ((q0**2 - ufl.dot(v, v)) * ufl.Identity(3) + 2 * ufl.outer(v, v) + 2 * q0 * hat(v)) / (
@@ -43,12 +50,16 @@ def body_rate(q, dq):
     With ``dq = q'`` this is the curvature of the rotation field; with ``dq`` a variation it is
     the virtual rotation in body axes. Independent of a (pointwise) scaling of ``q``.
     """
+    import ufl
+
     v, dv = quaternion_vector(q), quaternion_vector(dq)
     return 2 * (q[0] * dv - dq[0] * v - ufl.cross(v, dv)) / ufl.dot(q, q)
 
 
 def spatial_rate(q, dq):
     r"""Spatial rate :math:`\mathrm{axial}(\delta R\, R^T) = 2\,\mathrm{Im}(\delta q\,\bar q)/|q|^2`."""
+    import ufl
+
     v, dv = quaternion_vector(q), quaternion_vector(dq)
     return 2 * (q[0] * dv - dq[0] * v + ufl.cross(v, dv)) / ufl.dot(q, q)
 
@@ -59,6 +70,8 @@ def quaternion_rotation_vector(q):
     Continuous for angles up to 2π along a continuous quaternion field (q0 changes sign at π);
     near zero the series 2 v/q0 (1 − |v|²/(3 q0²)) replaces the quotient 0/0.
     """
+    import ufl
+
     v, q0 = quaternion_vector(q), q[0]
     vv = ufl.dot(v, v)
     norm_v = ufl.sqrt(vv + 1e-300)
