@@ -31,7 +31,7 @@ degree = 1
 at = "arm:start"
 fix = "all"
 displacement = [0.002, 0, 0]
-history = "sin(2*pi*5*t)"
+history = "1 - cos(2*pi*5*t)"
 
 [analysis]
 type = "transient"
