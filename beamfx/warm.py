@@ -25,7 +25,7 @@ import re
 import shutil
 import tempfile
 import time
-from dataclasses import replace
+from dataclasses import fields, is_dataclass, replace
 from pathlib import Path
 from typing import NamedTuple
 
@@ -139,15 +139,18 @@ def shortened(scene):
     """The scene with its time, arc-length or speed loop cut to its first steps (the same
     forms); static, eigen and adaptive scenes unchanged (adaptive: the solve picks the
     degree)."""
-    settings = dict(scene.settings)
-    ts = settings.get("transient")
-    if scene.analysis == "transient" and hasattr(ts, "dt"):
-        settings["transient"] = replace(ts, t_end=min(ts.t_end, 3 * ts.dt))
-    elif scene.analysis == "arclength" and "max_steps" in settings:
-        settings["max_steps"] = min(settings["max_steps"], 3)
-    elif scene.analysis == "rotating" and "speeds_rad_s" in settings:
-        settings["speeds_rad_s"] = tuple(settings["speeds_rad_s"][:2])
-    return scene if scene.accuracy else replace(scene, settings=settings)
+    settings = scene.settings
+    if scene.accuracy or not is_dataclass(settings):
+        return scene
+    names = {f.name for f in fields(settings)}
+    cut = {}
+    if {"t_end", "dt"} <= names:
+        cut["t_end"] = min(settings.t_end, 3 * settings.dt)
+    if "max_steps" in names:
+        cut["max_steps"] = min(settings.max_steps, 3)
+    if getattr(settings, "speeds_rad_s", None):
+        cut["speeds_rad_s"] = tuple(settings.speeds_rad_s[:2])
+    return replace(scene, settings=replace(settings, **cut)) if cut else scene
 
 
 def _cache_files(cache):

@@ -21,18 +21,14 @@ _spec.loader.exec_module(arch)
 KNOWN = {
     "import_cycles": [
         ["beamfx.analyses.checks", "beamfx.analyses.model"],
-        ["beamfx.runner", "beamfx.sweep"],
+        ["beamfx.bench.process", "beamfx.bench.run"],
     ],
     "long_functions": [
         "beamfx/analyses/continuation.py::trace_path",
         "beamfx/analyses/transient.py::solve_transient",
-        "beamfx/analyses/transient_run.py::run_transient",
         "beamfx/bench/adaptive_bend45.py::AdaptiveCase.run_setting",
         "beamfx/bench/run.py::markdown",
         "beamfx/bench/solid_scaling.py::report",
-        "beamfx/cli.py::main",
-        "beamfx/runner.py::run_scene",
-        "beamfx/scene/load.py::parse_scene",
         "beamfx/solvers/arclength.py::ArcLengthSolver.trace",
     ],
 }
