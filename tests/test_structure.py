@@ -1,5 +1,5 @@
 """The code's structure, read from its syntax trees: the analyses use formulations only through
-their protocol, no module calls another's private members, and imports have no cycles."""
+their protocol, no module calls another's private members, and the layers hold (no import cycles: tests/test_architecture.py)."""
 
 import ast
 from dataclasses import fields
@@ -159,102 +159,24 @@ def test_the_private_scan_flags_a_cross_call():
     assert private_reads(ast.parse(code), "x.py") == [("_y", 3)]
 
 
-# --- imports ----------------------------------------------------------------------------------
+# --- imports (the import graph of scripts/check_architecture.py; its cycles are checked in
+# tests/test_architecture.py) -------------------------------------------------------------------
 
 
-def import_graph(root):
-    """{module: modules it imports} of the package at ``root`` (function-level imports too:
-    a lazy import still ties the two modules together). ``from package import submodule``
-    points at the submodule, not at the package."""
-    modules = {}
-    for path in root.rglob("*.py"):
-        parts = list(path.relative_to(root.parent).with_suffix("").parts)
-        if parts[-1] == "__init__":
-            parts = parts[:-1]
-        modules[".".join(parts)] = path
-    graph = {}
-    for name, path in modules.items():
-        package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
-        edges = set()
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.Import):
-                edges.update(a.name for a in node.names if a.name in modules)
-            elif isinstance(node, ast.ImportFrom):
-                base = package[: len(package) - node.level + 1] if node.level else []
-                target = ".".join(base + ([node.module] if node.module else []))
-                subs = [f"{target}.{a.name}" for a in node.names]
-                subs = [s for s in subs if s in modules]
-                edges.update(subs)
-                if target in modules and len(subs) < len(node.names):
-                    edges.add(target)
-        graph[name] = edges - {name}
-    return graph
+def _import_graph():
+    import importlib.util
 
-
-def cycles(graph):
-    """Strongly connected components of more than one module (Tarjan), as sorted tuples."""
-    index, low, stack, on_stack, out = {}, {}, [], set(), []
-
-    def visit(v):
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on_stack.add(v)
-        for w in sorted(graph[v]):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on_stack:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            component = []
-            while True:
-                w = stack.pop()
-                on_stack.discard(w)
-                component.append(w)
-                if w == v:
-                    break
-            if len(component) > 1:
-                out.append(tuple(sorted(component)))
-
-    for v in sorted(graph):
-        if v not in index:
-            visit(v)
-    return out
-
-
-#: packages whose modules are in no import cycle at all
-ACYCLIC = ("analyses", "continuum", "geometry", "io", "physics", "solvers", "spec")
-#: cycles outside those packages that are known and not yet removed (this test only lets them
-#: shrink): the benchmark registry and its case modules
-KNOWN_CYCLES = ({"beamfx.bench"},)
-
-
-def test_no_import_cycles():
-    found = cycles(import_graph(PACKAGE))
-    for component in found:
-        touched = [m for m in component if m.split(".")[1] in ACYCLIC]
-        assert not touched, f"import cycle through {component}"
-        known = any(k <= set(component) for k in KNOWN_CYCLES)
-        assert known, f"new import cycle {component}"
-
-
-def test_the_cycle_scan_finds_a_lazy_import_cycle(tmp_path):
-    pkg = tmp_path / "pkg"
-    (pkg / "sub").mkdir(parents=True)
-    (pkg / "__init__.py").write_text("")
-    (pkg / "sub" / "__init__.py").write_text("from . import b\n")
-    (pkg / "a.py").write_text("def f():\n    from .sub.b import g\n")
-    (pkg / "sub" / "b.py").write_text("from ..a import f\n")
-    (pkg / "c.py").write_text("from .sub import b\n")
-    graph = import_graph(pkg)
-    assert graph["pkg.c"] == {"pkg.sub.b"}
-    assert cycles(graph) == [("pkg.a", "pkg.sub.b")]
+    script = PACKAGE.parent / "scripts" / "check_architecture.py"
+    spec = importlib.util.spec_from_file_location("check_architecture", script)
+    arch = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(arch)
+    return arch.import_graph()
 
 
 def test_layers():
     """geometry knows nothing of physics (its frames are NumPy); the model description
     (spec) imports no analyses."""
-    graph = import_graph(PACKAGE)
+    graph = _import_graph()
     for name, edges in graph.items():
         if name.startswith("beamfx.geometry"):
             assert all(e.startswith("beamfx.geometry") for e in edges), (name, edges)
