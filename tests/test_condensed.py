@@ -5,9 +5,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from beamfx.analyses.condensed import CondensedModel, RotationRangeError, condensed_fit
+from beamfx.analyses.condensed import CondensedModel, RotationRangeError
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
+from beamfx.analyses.trimming import condensed_fit
 from beamfx.bench.howcroft_2016 import _build
 from beamfx.io import evaluate_points
 from beamfx.spec import PointLoad

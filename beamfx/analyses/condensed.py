@@ -5,7 +5,7 @@ In a statically determinate beam the section force is known from the loads, n(s)
 of the forces beyond s, so the strains Γ = C_N⁻¹ Λ0ᵀ Rᵀ n can be eliminated from the
 Simo–Reissner energy exactly (:func:`~beamfx.physics.condensed.load_potential`): same
 equilibrium, shear and stretch kept (or dropped, with ``[model] shear``/``stretch`` false: the
-Kirchhoff rod), a fraction of the unknowns. :func:`condensed_fit` says where it applies: a
+Kirchhoff rod), a fraction of the unknowns. :func:`~beamfx.analyses.trimming.condensed_fit` says where it applies: a
 static analysis of one beam clamped at its start, loaded by point loads (dead or follower
 forces; dead, follower or semitangential moments) and nothing else.
 
@@ -27,10 +27,11 @@ from mpi4py import MPI
 
 from ..physics import condensed as rod
 from ..physics.rotations import np_exp_rotation
-from ..spec import DOF_NAMES, resolve_point
+from ..spec import resolve_point
 from .discretisation import Discretised, discretise
 from .dofs import constrained_dofs, global_size, owned_size
 from .model import BeamModel
+from .trimming import condensed_fit
 
 #: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
 MAX_ANGLE = np.radians(330.0)
@@ -41,37 +42,6 @@ class RotationRangeError(ValueError):
 
 
 #: moment kinds with a local virtual work in g
-MOMENT_KINDS = ("dead", "follower", "semitangential")
-
-
-def condensed_fit(model, analysis="static"):
-    """None if the condensed model applies to ``model`` and ``analysis``, else why not."""
-    kin = model.kinematics
-    if analysis != "static":
-        return f"it solves static analyses only, not {analysis!r}"
-    if not kin.finite:
-        return "the kinematics are linear (one linear solve already)"
-    if kin.plane:
-        return "the planar model has as few unknowns per node"
-    if len(model.beams) != 1:
-        return "it models one beam"
-    if len(model.supports) != 1:
-        return "it models a cantilever (one support, clamped)"
-    sup = model.supports[0]
-    if set(sup.fix) != set(DOF_NAMES) or any(sup.displacement) or any(sup.rotation):
-        return "the support is not a clamp with zero displacement and rotation"
-    if sup.history is not None or resolve_point(model, sup.at)[1] != 0.0:
-        return "the clamp is not at the beam's start"
-    if model.distributed_loads or any(model.gravity):
-        return "distributed loads (and gravity) are not implemented in it"
-    if model.springs or model.point_masses:
-        return "springs and point masses are not implemented in it"
-    for ld in model.point_loads:
-        if ld.history is not None:
-            return "a load has a history"
-        if any(ld.moment) and ld.kind not in MOMENT_KINDS:
-            return f"a {ld.kind} moment is not implemented in it (allowed {list(MOMENT_KINDS)})"
-    return None
 
 
 def build_model(model, comm, extra_points=(), condense=False):

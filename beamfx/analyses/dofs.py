@@ -7,7 +7,6 @@ ghosts, so a reduction over ranks counts a dof once when it looks at owned entri
 """
 
 import numpy as np
-from mpi4py import MPI
 
 from ..spec import DOF_NAMES
 
@@ -83,6 +82,8 @@ def point_displacement(model, dofs, values=None):
     values = model.w.x.array if values is None else values
     local = np.array([values[d].sum() for d in dofs])
     count = np.array([len(d) for d in dofs], float)
+    from mpi4py import MPI
+
     total = model.comm.allreduce(local, op=MPI.SUM)
     n = model.comm.allreduce(count, op=MPI.SUM)
     return total / np.maximum(n, 1)

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..geometry.frames import section_axes_at
 from ..physics.kinematics import PLANES
-from ..spec import DOF_NAMES
+from ..spec import DOF_NAMES, resolve_point
 from .checks import free_rigid_modes, model_size
 
 #: analyses whose answer includes out-of-plane motion of a plane structure
@@ -170,11 +170,47 @@ def trimming_summary(trim, kin, unknowns):
     return line, entry
 
 
+#: moments the statically condensed model takes (analyses/condensed.py)
+MOMENT_KINDS = ("dead", "follower", "semitangential")
+
+
+def condensed_fit(model, analysis="static"):
+    """None if the condensed model applies to ``model`` and ``analysis``, else why not."""
+    kin = model.kinematics
+    if analysis != "static":
+        return f"it solves static analyses only, not {analysis!r}"
+    if not kin.finite:
+        return "the kinematics are linear (one linear solve already)"
+    if kin.plane:
+        return "the planar model has as few unknowns per node"
+    if len(model.beams) != 1:
+        return "it models one beam"
+    if len(model.supports) != 1:
+        return "it models a cantilever (one support, clamped)"
+    sup = model.supports[0]
+    if set(sup.fix) != set(DOF_NAMES) or any(sup.displacement) or any(sup.rotation):
+        return "the support is not a clamp with zero displacement and rotation"
+    if sup.history is not None or resolve_point(model, sup.at)[1] != 0.0:
+        return "the clamp is not at the beam's start"
+    if model.distributed_loads or any(model.gravity):
+        return "distributed loads (and gravity) are not implemented in it"
+    if model.springs or model.point_masses:
+        return "springs and point masses are not implemented in it"
+    for ld in model.point_loads:
+        if ld.history is not None:
+            return "a load has a history"
+        if any(ld.moment) and ld.kind not in MOMENT_KINDS:
+            return f"a {ld.kind} moment is not implemented in it (allowed {list(MOMENT_KINDS)})"
+    return None
+
+
 __all__ = [
+    "MOMENT_KINDS",
     "NEVER_TRIMMED",
     "PLANE_CHOICES",
     "Trim",
     "choose_plane",
+    "condensed_fit",
     "plane_fit",
     "trimming_summary",
 ]

@@ -46,8 +46,8 @@ class AdaptiveCase(Case):
 
         from ..analyses import static_run
         from ..analyses.adaptive import refine_to_tolerance, solve_once
-        from ..analyses.condensed import condensed_fit
         from ..analyses.static import solve_static
+        from ..analyses.trimming import condensed_fit
         from ..scene.load import Scene
         from ..solvers import NewtonSolver
 

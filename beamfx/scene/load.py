@@ -342,7 +342,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
     _check_points(model, probes, file)
     model, trimming = _trim(model, plane, analysis, settings)
     if condense == "auto":
-        from ..analyses.condensed import condensed_fit
+        from ..analyses.trimming import condensed_fit
 
         condense = condensed_fit(model, analysis.name) is None
     else:
