@@ -278,10 +278,10 @@ class EnergyBalance:
         self.residual = residual
         self.moving = any(s.history is not None for s in m.spec.supports)
         self.vec = fp.create_vector(self.residual)
-        self.mask = np.zeros(len(m.w.x.array), bool)  # constrained, owned dofs
-        self.mask[constrained_dofs(m.bcs)] = True
         self.n_owned = owned_size(m.W)
-        self.mask[self.n_owned :] = False
+        mask = np.zeros(len(m.w.x.array), bool)
+        mask[constrained_dofs(m.bcs)] = True
+        self.mask = mask[: self.n_owned]  # constrained, owned dofs (as _vector's rows)
         self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
         self.previous = self.initial = None
 
