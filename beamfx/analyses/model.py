@@ -19,6 +19,19 @@ from .discretisation import Discretised, discretise
 from .dofs import global_size, subspace_dofs
 
 
+def _check_partition(mesh, comm):
+    """Every rank must own a cell: the quaternion model aborts (SEGV in PETSc) on a rank
+    without one, so refuse before that with the numbers."""
+    cells = mesh.topology.index_map(mesh.topology.dim).size_local
+    empty = comm.allreduce(int(cells == 0))
+    if empty:
+        total = comm.allreduce(cells)
+        raise ValueError(
+            f"{total} element(s) on {comm.size} MPI ranks leave {empty} rank(s) without one: "
+            "use more elements or fewer ranks"
+        )
+
+
 class BeamModel(Discretised):
     """The discrete Simo–Reissner model of a :class:`~beamfx.spec.Model`: a
     :class:`~beamfx.analyses.formulation.BeamFormulation`.
@@ -37,6 +50,7 @@ class BeamModel(Discretised):
         self.spec, self.kin = model, model.kinematics
         check_planar(model)
         self.discretisation = d = discretise(model, comm, extra_points)
+        _check_partition(d.mesh.mesh, comm)
         m, p = d.mesh.mesh, d.degree
         # the quaternion penalty: 10 times the largest EA or GA (before the section limits)
         self.k_penalty = fem.Constant(m, PETSc.ScalarType(10 * d.stiffness_scale))
