@@ -95,6 +95,7 @@ def run_scene(
     scene, refinement = _refine(scene, comm, log)
     ctx = _context(scene, out, comm, log, restart, png or animate)
     result = analysis(scene.analysis).run(ctx.model, scene.settings, ctx)
+    ctx.frames.close()
     run = RunResult(
         str(path),
         result,
@@ -108,10 +109,13 @@ def run_scene(
 
 
 def _prepare(out, comm):
-    """The output folder, checked writable, without a stale results.json."""
+    """The output folder, checked writable, without a stale results.json; the frame writers'
+    library imported (VTK before DOLFINx) or its absence reported, before any model is built."""
     from .io import check_writable
+    from .io.output import OutputSettings, prepare_output
 
     check_writable(out, comm)
+    prepare_output(OutputSettings(dir=str(out)))
     if comm.rank == 0 and (out / "results.json").exists():
         os.remove(out / "results.json")
     return out
@@ -151,6 +155,7 @@ def _context(scene, out, comm, log, restart, pictures):
     """The model and the run context of the scene's analysis."""
     from .analyses.context import RunContext
     from .analyses.trimming import Trim, trimming_summary
+    from .io.output import FrameWriter, OutputSettings
 
     model = _build(scene, comm, log, scene.condense)
     trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
@@ -163,7 +168,13 @@ def _context(scene, out, comm, log, restart, pictures):
             f"{model.unknowns() // 3 * per_node}; shear and stretch kept"
         )
     every = getattr(scene.settings, "frames_every", 1)
-    frames = _Frames(out, model, scene.model.beams, every, comm, pictures)
+    frames = FrameWriter(
+        out, model, OutputSettings(dir=str(out), every=every), scene.model.beams, comm
+    )
+    if pictures:
+        from .io.pictures import write_undeformed
+
+        write_undeformed(out, model, [b.name for b in scene.model.beams], frames.outlines)
     full = partial(_build, replace(scene, condense=False), comm, log, False)
     return RunContext(
         scene.analysis,
@@ -242,56 +253,3 @@ def check_scene(path):
     for scene in [m.scene for m in loaded.members] if isinstance(loaded, Sweep) else [loaded]:
         check_supported(scene.model)
     return loaded
-
-
-class _Frames:
-    """The ParaView series of a run (to be replaced by beamfx.io.output.FrameWriter)."""
-
-    def __init__(self, out, model, beams, every, comm, pictures):
-        from .io import PvdSeries, XdmfSeries
-        from .io.surface import SurfaceSeries, model_outlines, write_paraview_script
-
-        names = [b.name for b in beams]
-        self.outlines = model_outlines(beams)
-        self.model, self.out, self.every, self.written = model, out, every, set()
-        self.pvd, self.xdmf = (
-            PvdSeries(out / "deformed.pvd", comm),
-            XdmfSeries(out / "deformed.xdmf", comm),
-        )
-        self.surface = SurfaceSeries(
-            out / "surface.pvd", model.degree, names, self.outlines, comm=comm
-        )
-        write_paraview_script(out, comm)
-        if pictures:
-            from .io.pictures import write_undeformed
-
-            write_undeformed(out, model, names, self.outlines)  # before the solve: w = 0
-
-    def want(self, step, time, last=False):
-        return last or step % self.every == 0
-
-    def has(self, step):
-        return step in self.written
-
-    def write(self, step, time):
-        from .io import nodal_fields, write_vtu
-
-        fields = nodal_fields(self.model)
-        vtu = self.out / f"deformed_{step:04d}.vtu"
-        write_vtu(vtu, fields, self.model.comm)
-        self.pvd.add(time, vtu)
-        self.xdmf.add(time, fields)
-        self.surface.add(step, time, fields)
-        self.written.add(step)
-
-    def resume(self, t):
-        for series in (self.pvd, self.xdmf, self.surface.pvd):
-            series.resume(t)
-
-    def files(self):
-        return {
-            "pvd": "deformed.pvd",
-            "xdmf": "deformed.xdmf",
-            **({"surface": "surface.pvd"} if any(self.outlines.values()) else {}),
-            "script": "open_in_paraview.py",
-        }

@@ -5,6 +5,13 @@ os.environ.setdefault("SETUPTOOLS_USE_DISTUTILS", "stdlib")
 import numpy as np
 import pytest
 
+from beamfx.io.vtkfiles import import_vtk
+
+try:  # VTK's wheel before DOLFINx in one process (the frame writers use it)
+    import_vtk()
+except RuntimeError:
+    pass
+
 
 def nodal(model, sub):
     """Coordinates and values (n, comps) of the displacement (0) or rotation (1) nodes."""

@@ -6,11 +6,13 @@ x = L sin φ / φ, z = L (1 - cos φ) / φ, turned by φ about -y, and everywher
 M_y = -M (section axes = global axes here, since Λ0 = I). With k = M L / (2π EI) = 1/2 the
 beam is a half circle: tip at (0, 0, 2L/π) turned by π.
 
-MPI: probes are the same on every rank; nodal fields and files live on rank 0, where they
-are checked (the file name is rank 0's tmp_path).
+MPI: probes are the same on every rank; gathered nodal fields live on rank 0, where the
+frames (each rank writes its own piece) are read back and checked (the folder is rank 0's
+tmp_path). tests/test_output_mpi.py compares the pieces of 2 ranks with 1 rank's file.
 """
 
 import io
+import itertools
 import json
 import os
 import xml.etree.ElementTree as ET
@@ -23,18 +25,18 @@ from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
 from beamfx.geometry import Line
 from beamfx.io import (
+    FrameWriter,
+    OutputSettings,
     Progress,
-    PvdSeries,
-    XdmfSeries,
     check_writable,
     evaluate_points,
     log,
     nodal_fields,
     track_rotations,
     write_json_atomic,
-    write_vtu,
 )
 from beamfx.io._sections import rotation_matrices
+from beamfx.io.output import FramePolicy, default_every
 from beamfx.physics.kinematics import Kinematics
 from beamfx.physics.rotations import np_quaternion, np_rotation
 from beamfx.physics.sections import Section
@@ -193,66 +195,154 @@ def test_linear_cantilever_resultants_exact():
         assert np.allclose(f["N"][:, 2], P, atol=1e-9 * P)
 
 
-def _parse_vtu(path):
-    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
-    arrays = {}
-    for parent in ("PointData", "Points", "Cells"):
-        for a in piece.find(parent).findall("DataArray"):
-            values = np.array(a.text.split(), dtype=float)
-            ncomp = int(a.get("NumberOfComponents", "1"))
-            arrays[a.get("Name", parent)] = values.reshape(-1, ncomp)
-    return int(piece.get("NumberOfPoints")), int(piece.get("NumberOfCells")), arrays
+def read_frame(path):
+    """(points, {point array}, {cell array}, cell types, cells as point index lists) of a
+    .vtu or .pvtu (pieces merged in file order)."""
+    import pyvista as pv
+
+    grid = pv.read(path)
+    offsets, conn = np.asarray(grid.cell_offsets), np.asarray(grid.cell_connectivity)
+    cells = [conn[a:b] for a, b in itertools.pairwise(offsets)]
+    point_data = {k: np.asarray(grid.point_data[k]) for k in grid.point_data}
+    cell_data = {k: np.asarray(grid.cell_data[k]) for k in grid.cell_data}
+    return np.asarray(grid.points), point_data, cell_data, np.asarray(grid.celltypes), cells
 
 
-def test_paraview_files_parse_back(half_circle, tmp_path):
+def pvd_entries(path):
+    """[(time, file)] of a .pvd; parsing it checks that it is valid XML."""
+    root = ET.parse(path).getroot()
+    return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
+
+
+def frame_file(folder, stem, step):
+    return os.path.join(folder, f"{stem}_{step:04d}.{'vtu' if comm.size == 1 else 'pvtu'}")
+
+
+def test_frames_read_back_equal_the_fields(half_circle, tmp_path):
+    """The centre line frame: one Lagrange curve of k + 1 points per element, through the
+    nodes in the order ends first; points X + u and every array equal to the fields."""
     model, _ = half_circle
     folder = shared_tmp(tmp_path)
-    check_writable(folder)
+    writer = FrameWriter(folder, model, OutputSettings(), model.spec.beams, comm)
+    for step, t in ((1, 0.5), (2, 1.0)):
+        writer.write(step, t)
+        comm.barrier()
+        if comm.rank == 0:  # the index is valid after every frame and lists them all
+            assert pvd_entries(os.path.join(folder, "deformed.pvd"))[-1][0] == t
+            assert len(pvd_entries(os.path.join(folder, "deformed.pvd"))) == step
+    writer.close()
     f = nodal_fields(model)
-    pvd = PvdSeries(os.path.join(folder, "beam.pvd"))
-    xdmf = XdmfSeries(os.path.join(folder, "beam.xdmf"))
-    for step, t in enumerate((0.5, 1.0)):
-        vtu = os.path.join(folder, f"beam_{step}.vtu")
-        write_vtu(vtu, f)
-        pvd.add(t, vtu)
-        xdmf.add(t, f)
-        if comm.rank == 0:  # both series are complete, valid files after every step
-            assert len(list(ET.parse(os.path.join(folder, "beam.xdmf")).iter("Time"))) == step + 1
-            assert len(list(ET.parse(os.path.join(folder, "beam.pvd")).iter("DataSet"))) == step + 1
     if comm.rank != 0:
         return
-    n_pts, n_cells = ELEMENTS * (DEGREE + 1), ELEMENTS * DEGREE
+    # a section given by its stiffnesses only has no outline: no surface
+    assert writer.files() == {"pvd": "deformed.pvd", "script": "open_in_paraview.py"}
+    assert [e[0] for e in pvd_entries(os.path.join(folder, "deformed.pvd"))] == [0.5, 1.0]
+    points, point_data, cell_data, types, cells = read_frame(frame_file(folder, "deformed", 2))
+    assert len(cells) == ELEMENTS and np.all(types == 68)  # VTK_LAGRANGE_CURVE
+    assert all(len(c) == DEGREE + 1 for c in cells)
+    order = np.argsort(cell_data["cell"])
+    assert np.array_equal(cell_data["cell"][order], np.arange(ELEMENTS))
+    along = np.array([0, DEGREE, *range(1, DEGREE)])  # VTK: the two ends, then the interior
+    nodes = np.concatenate([np.asarray(cells[c])[np.argsort(along)] for c in order])
+    assert np.allclose(points[nodes], f["X"] + f["u"], rtol=0, atol=1e-14 * L)
+    for name in ("X", "u", "e1", "e2", "e3", "N", "M"):
+        assert np.array_equal(point_data[name][nodes], f[name]), name
+    assert np.array_equal(cell_data["beam"], np.zeros(ELEMENTS))
 
-    n, nc, arrays = _parse_vtu(os.path.join(folder, "beam_1.vtu"))
-    assert (n, nc) == (n_pts, n_cells)
-    for name in ("X", "u", "e1", "e2", "e3", "N", "M", "Points"):
-        assert arrays[name].shape == (n_pts, 3), name
-    assert np.allclose(arrays["Points"], f["X"] + f["u"], rtol=1e-15, atol=0)
-    assert arrays["connectivity"].size == 2 * n_cells
-    assert arrays["connectivity"].max() == n_pts - 1
-    assert np.all(arrays["types"] == 3)
 
-    sets = ET.parse(os.path.join(folder, "beam.pvd")).getroot().findall("Collection/DataSet")
-    assert [float(d.get("timestep")) for d in sets] == [0.5, 1.0]
-    assert all(os.path.exists(os.path.join(folder, d.get("file"))) for d in sets)
-    assert all(not os.path.isabs(d.get("file")) for d in sets)
+def test_surface_frame_is_the_swept_section(half_circle, tmp_path):
+    """The surface of the rectangle: every face lies at half the section from the centre
+    line, the end caps close the beam's two ends, the cell data name the element."""
+    from dataclasses import replace
 
-    series = ET.parse(os.path.join(folder, "beam.xdmf")).getroot().find("Domain/Grid")
-    assert series.get("CollectionType") == "Temporal"
-    grids = series.findall("Grid")
-    assert [float(g.find("Time").get("Value")) for g in grids] == [0.5, 1.0]
-    for g in grids:
-        topo = g.find("Topology")
-        assert (topo.get("TopologyType"), topo.get("NodesPerElement")) == ("Polyline", "2")
-        assert np.array(topo.find("DataItem").text.split(), int).size == 2 * n_cells
-        geo = g.find("Geometry/DataItem")
-        assert np.array(geo.text.split(), float).reshape(-1, 3).shape == (n_pts, 3)
-        atts = {a.get("Name"): a for a in g.findall("Attribute")}
-        assert {"X", "u", "e1", "e2", "e3", "N", "M"} <= set(atts)
-        for name in ("u", "N", "M"):
-            assert atts[name].get("AttributeType") == "Vector"
-            assert atts[name].find("DataItem").get("Format") == "XML"
-            assert np.array(atts[name].find("DataItem").text.split(), float).size == 3 * n_pts
+    model, _ = half_circle
+    folder = shared_tmp(tmp_path)
+    h, w = 0.2, 0.1
+    section = replace(SECTION, shape=("rectangle", h, w))
+    beams = tuple(replace(b, section=section) for b in model.spec.beams)
+    writer = FrameWriter(folder, model, OutputSettings(formats=("surface",)), beams, comm)
+    assert writer.files() == {"surface": "surface.pvd"}  # no centre line, so no script
+    writer.write(1, 1.0)
+    comm.barrier()
+    if comm.rank != 0:
+        return
+    points, point_data, cell_data, types, _ = read_frame(frame_file(folder, "surface", 1))
+    assert set(np.unique(cell_data["cell"])) == set(range(ELEMENTS))
+    assert np.sum(types == 7) == 2  # VTK_POLYGON: one cap at each end of the beam
+    assert np.sum(types == 9) == ELEMENTS * 4 * 4  # quads: 4 sides, 4 subdivisions
+    # the half circle of radius L/π about (0, ·, L/π) in the x-z plane: the section's height
+    # h along e3 lies in that plane, its width w along y
+    centre = np.array([0.0, 0.0, L / np.pi])
+    radial = np.hypot(points[:, 0] - centre[0], points[:, 2] - centre[2])
+    sides = np.isclose(np.abs(points[:, 1]), w / 2, atol=1e-12)
+    assert sides.all()
+    assert np.allclose(
+        np.sort(np.unique(np.round(radial, 4))), [L / np.pi - h / 2, L / np.pi + h / 2], atol=1e-4
+    )
+    assert {"u", "N", "M"} <= set(point_data)
+
+
+def test_resume_keeps_earlier_frames_and_drops_later_ones(half_circle, tmp_path):
+    model, _ = half_circle
+    folder = shared_tmp(tmp_path)
+    settings = OutputSettings(formats=("vtu",))
+    writer = FrameWriter(folder, model, settings, model.spec.beams, comm)
+    for step in range(1, 5):
+        writer.write(step, 0.25 * step)
+    restarted = FrameWriter(folder, model, settings, model.spec.beams, comm)
+    restarted.resume(0.5)
+    comm.barrier()
+    index = os.path.join(folder, "deformed.pvd")
+    if comm.rank == 0:
+        assert [t for t, _ in pvd_entries(index)] == [0.25, 0.5]
+        assert os.path.exists(frame_file(folder, "deformed", 2))
+        assert not os.path.exists(frame_file(folder, "deformed", 3))
+        assert not [n for n in os.listdir(folder) if n.startswith("deformed_0004")]
+    comm.barrier()
+    restarted.write(3, 0.75)
+    comm.barrier()
+    if comm.rank == 0:
+        assert [t for t, _ in pvd_entries(index)] == [0.25, 0.5, 0.75]
+    fresh = FrameWriter(folder, model, settings, model.spec.beams, comm)  # a new run
+    fresh.write(1, 1.0)
+    comm.barrier()
+    if comm.rank == 0:
+        assert [t for t, _ in pvd_entries(index)] == [1.0]
+        assert not os.path.exists(frame_file(folder, "deformed", 2))  # the old run's files
+
+
+def _frames(policy, times):
+    """The steps a run of ``times`` writes, asking ``policy`` and recording as the writer does."""
+    out = []
+    for step, t in enumerate(times, start=1):
+        if policy.want(step, t, last=step == len(times)):
+            policy.record(step, t)
+            out.append(step)
+    return out
+
+
+def test_output_policy_every_times_and_last():
+    steps = np.arange(1, 11) * 0.1  # 10 steps to t = 1 (0.30000000000000004, ...)
+    assert _frames(FramePolicy(OutputSettings()), steps) == list(range(1, 11))
+    assert _frames(FramePolicy(OutputSettings(every=3)), steps) == [3, 6, 9, 10]  # + the last
+    assert _frames(FramePolicy(OutputSettings(every=5)), steps) == [5, 10]  # the last once
+    # the first step at or past each time (0.3 reached by 0.30000000000000004); one frame
+    # where a step passes two times
+    policy = FramePolicy(OutputSettings(times=(0.25, 0.3, 0.32, 0.7)))
+    assert _frames(policy, steps) == [3, 4, 7, 10]
+    policy = FramePolicy(OutputSettings(times=(0.25, 0.55)))
+    policy.resume(0.5)  # restarted at 0.5: 0.25 is done, 0.55 still to come
+    assert not policy.want(6, 0.52) and policy.want(7, 0.6)
+    assert default_every("transient", 1440) == 7 and default_every("static", 40) == 1
+
+
+def test_output_settings_problems():
+    assert list(OutputSettings().problems()) == []
+    keys = [k for k, _ in OutputSettings(every=2, times=(1.0,)).problems()]
+    assert keys == ["times"]
+    assert [k for k, _ in OutputSettings(times=(2.0, 1.0)).problems()] == ["times"]
+    assert [k for k, _ in OutputSettings(formats=("vtu", "vtu")).problems()] == ["formats"]
+    assert OutputSettings().formats == ("vtu", "surface")  # XDMF is not a default
 
 
 def test_json_atomic_and_writable(tmp_path):

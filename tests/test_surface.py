@@ -51,7 +51,8 @@ def outward(points, cell):
     ],
 )
 def test_swept_surface(outline, rings_points, caps):
-    points, cells, types, data = surface_mesh(straight_fields(), K, ["b"], {"b": outline}, SUB)
+    mesh = surface_mesh(straight_fields(), K, ["b"], {"b": outline}, SUB)
+    points, cells, types, data = mesh.points, mesh.cells(), mesh.types, mesh.point_data
     samples = ELEMENTS * (SUB + 1)
     assert len(points) == samples * rings_points
     along = ELEMENTS * SUB * rings_points
@@ -69,9 +70,32 @@ def test_swept_surface(outline, rings_points, caps):
         hole = len(outline) == 2 and np.allclose(r, inner)  # the hole's wall: towards the axis
         assert outward(points, c) * (-1 if hole else 1) > 0
     assert np.allclose(data["u"], U) and np.allclose(data["M"], [0, 1, 0])
+    # cell data: the element of every face (the caps: the first and the last element)
+    element = mesh.cell_data["cell"]
+    assert np.array_equal(element[:along], np.repeat(np.arange(ELEMENTS), along // ELEMENTS))
+    assert sorted(set(element[along:].tolist())) == [0, ELEMENTS - 1]
+    assert np.all(mesh.cell_data["beam"] == 0)
+
+
+def test_pieces_of_elements_make_the_whole_surface():
+    """The surface of each element alone, with the beam's ends given, has the caps only at
+    the beam's ends: the pieces of several ranks together are the surface of one."""
+    fields = straight_fields()
+    outline = {"b": section_outline("rectangle", h=1.0, w=0.5)}
+    whole = surface_mesh(fields, K, ["b"], outline, SUB)
+    n = K + 1
+    pieces = []
+    for e in range(ELEMENTS):
+        one = {k: v[e * n : (e + 1) * n] for k, v in fields.items()}
+        one["cell"], one["beam"] = np.array([e]), np.array([0])
+        pieces.append(surface_mesh(one, K, ["b"], outline, SUB, ends=([0], [ELEMENTS - 1])))
+    assert sum(len(p.types) for p in pieces) == len(whole.types)
+    assert np.allclose(np.concatenate([p.points for p in pieces]), whole.points)
+    caps = [int(np.sum(p.types == VTK_POLYGON)) for p in pieces]
+    assert caps == [1, 1]  # the start cap on element 0, the end cap on element 1
 
 
 def test_general_section_has_no_outline():
     assert section_outline("general") is None
-    points, cells, _, _ = surface_mesh(straight_fields(), K, ["b"], {"b": None})
-    assert len(points) == 0 and cells == []
+    mesh = surface_mesh(straight_fields(), K, ["b"], {"b": None})
+    assert len(mesh.points) == 0 and mesh.cells() == [] and len(mesh.types) == 0

@@ -20,6 +20,7 @@ NumPy from ``rot`` and ``Lam0`` (:func:`rotation_matrices`).
 """
 
 import weakref
+from functools import lru_cache
 
 import numpy as np
 import ufl
@@ -48,10 +49,14 @@ def section_expression(model):
     return ufl.as_vector(flat), layout
 
 
+@lru_cache
 def gauss_points(degree):
-    """The ``degree`` Gauss–Legendre points on [0, 1]: the shear/axial rule of the model."""
+    """The ``degree`` Gauss–Legendre points on [0, 1]: the shear/axial rule of the model
+    (cached; read only)."""
     g, _ = np.polynomial.legendre.leggauss(degree)
-    return (g + 1) / 2
+    g = (g + 1) / 2
+    g.flags.writeable = False
+    return g
 
 
 def lagrange_matrix(nodes, x):
@@ -104,13 +109,19 @@ def evaluate(model, points, cells, recover=True):
     n = len(points)
     out = {name: values[:, :n, s] for name, s in layout.items()}
     if recover:
-        A = lagrange_matrix(gauss, points)
+        A = _recovery_matrix(model.degree, key[:n])
         for name in ("N", "M"):
             out[name] = np.einsum("pg,cgi->cpi", A, values[:, n:, layout[name]])
     out["Lam0"] = out["Lam0"].reshape(len(cells), n, 3, 3)
     R = rotation_matrices(model.kin.finite, out["rot"].reshape(-1, model.kin.output_rotation_size))
     out["axes"] = (R @ out["Lam0"].reshape(-1, 3, 3)).reshape(len(cells), n, 3, 3)
     return out
+
+
+@lru_cache
+def _recovery_matrix(degree, points):
+    """Values at ``points`` (a tuple) of the Lagrange polynomials through the Gauss points."""
+    return lagrange_matrix(gauss_points(degree), np.asarray(points))
 
 
 def rotation_matrices(finite, rot):

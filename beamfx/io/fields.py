@@ -1,4 +1,4 @@
-"""Nodal fields of the whole beam for plotting, gathered to rank 0.
+"""Nodal fields of the beam for plotting: per rank (:func:`local_fields`) or gathered to rank 0.
 
 Each owned cell contributes its k + 1 nodes at ξ = 0, 1/k, ..., 1 (k the degree), in order
 along the cell; nodes are duplicated between cells, so the representation is discontinuous
@@ -12,8 +12,9 @@ from ._sections import evaluate
 POINT_ARRAYS = ("X", "u", "e1", "e2", "e3", "N", "M")
 
 
-def nodal_fields(model, recover=True):
-    """Centre line, displacement, section axes and stress resultants at the nodes. Collective.
+def local_fields(model, recover=True):
+    """The nodal fields of the cells this rank owns, in input order. Collective the first
+    time (the section expression is compiled), then local.
 
     Args:
         model: :class:`~beamfx.analyses.model.BeamModel` (its current ``w``).
@@ -21,39 +22,54 @@ def nodal_fields(model, recover=True):
             taken pointwise, see :func:`beamfx.io._sections.evaluate`.
 
     Returns:
-        On rank 0 a dict of NumPy arrays over ``n = cells·(k+1)`` points, cells in input order
-        (the same in serial and parallel): ``X`` reference position and ``u`` displacement
+        dict of NumPy arrays over the ``n = cells·(k+1)`` points of the owned cells, sorted by
+        their input (original) cell index: ``X`` reference position and ``u`` displacement
         (n, 3, global axes); ``e1, e2, e3`` current section axes R·Λ0 (n, 3, global axes);
-        ``N`` and ``M`` section force and moment (n, 3, section axes); ``beam`` the beam
-        index of each point (n,); ``cells`` the (cells·k, 2) line segments of the polyline.
-        None on the other ranks.
+        ``N`` and ``M`` section force and moment (n, 3, section axes); per cell ``cell`` its
+        input index and ``beam`` its beam index (cells,).
     """
     model.sync()  # derived fields (the condensed model integrates its displacement)
     m = model.mesh.mesh
     k = model.degree
-    xi = np.linspace(0.0, 1.0, k + 1)[:, None]
     n_owned = m.topology.index_map(m.topology.dim).size_local
-    values = evaluate(model, xi, np.arange(n_owned, dtype=np.int32), recover)
-    local = {
-        "X": values["X"],
-        "u": values["u"],
-        "e1": values["axes"][..., 0],
-        "e2": values["axes"][..., 1],
-        "e3": values["axes"][..., 2],
-        "N": values["N"],
-        "M": values["M"],
-        "beam": np.repeat(np.asarray(model.mesh.cell_beam[:n_owned], float)[:, None], k + 1, 1),
-        "order": np.asarray(m.topology.original_cell_index[:n_owned]),
-    }
-    parts = model.comm.gather(local, root=0)
+    original = np.asarray(m.topology.original_cell_index[:n_owned], dtype=np.int64)
+    order = np.argsort(original, kind="stable")
+    cells = np.arange(n_owned, dtype=np.int32)[order]
+    values = evaluate(model, np.linspace(0.0, 1.0, k + 1)[:, None], cells, recover)
+    axes = values["axes"]
+    out = {"X": values["X"], "u": values["u"], "N": values["N"], "M": values["M"]}
+    out.update(e1=axes[..., 0], e2=axes[..., 1], e3=axes[..., 2])
+    out = {name: np.ascontiguousarray(out[name]).reshape(-1, 3) for name in POINT_ARRAYS}
+    out["cell"] = original[order]
+    out["beam"] = np.asarray(model.mesh.cell_beam[:n_owned], dtype=np.int64)[order]
+    return out
+
+
+def nodal_fields(model, recover=True):
+    """Centre line, displacement, section axes and stress resultants at the nodes, gathered
+    to rank 0. Collective.
+
+    Args:
+        model: :class:`~beamfx.analyses.model.BeamModel` (its current ``w``).
+        recover: as in :func:`local_fields`.
+
+    Returns:
+        On rank 0 the arrays of :func:`local_fields` of all cells in input order (the same in
+        serial and parallel), except that ``beam`` is per point (n,), plus ``cells`` the
+        (cells·k, 2) line segments of the polyline through the nodes. None on the other ranks.
+    """
+    k = model.degree
+    parts = model.comm.gather(local_fields(model, recover), root=0)
     if model.comm.rank != 0:
         return None
-    order = np.argsort(np.concatenate([p["order"] for p in parts]), kind="stable")
+    order = np.argsort(np.concatenate([p["cell"] for p in parts]), kind="stable")
+    per_cell = (len(order), k + 1)
     out = {}
-    for name in (*POINT_ARRAYS, "beam"):
-        a = np.concatenate([p[name] for p in parts])[order]  # (cells, k+1, ...)
-        out[name] = a.reshape(-1, *a.shape[2:])
-    n_cells = len(order)
-    first = (k + 1) * np.arange(n_cells)[:, None] + np.arange(k)[None, :]
+    for name in POINT_ARRAYS:
+        a = np.concatenate([p[name].reshape(-1, k + 1, 3) for p in parts])[order]
+        out[name] = a.reshape(-1, 3)
+    beam = np.concatenate([p["beam"] for p in parts])[order]
+    out["beam"] = np.broadcast_to(beam[:, None], per_cell).astype(float).ravel()
+    first = (k + 1) * np.arange(len(order))[:, None] + np.arange(k)[None, :]
     out["cells"] = np.stack([first.ravel(), first.ravel() + 1], axis=1).astype(np.int64)
     return out

@@ -48,10 +48,10 @@ def write_undeformed(folder, model, beam_names, outlines):
     """``undeformed.vtu``: the section surface of the reference state. Collective; call it
     before the solve (``model.w`` still zero)."""
     from .fields import nodal_fields
-    from .paraview import write_unstructured_vtu
-    from .surface import surface_mesh
+    from .surface import surface_grid, surface_mesh
+    from .vtkfiles import write_grid
 
-    fields = nodal_fields(model)
+    fields = nodal_fields(model)  # gathered: one small file, once
     if model.comm.rank != 0:
         return
     path = os.path.join(folder, "undeformed.vtu")
@@ -60,8 +60,8 @@ def write_undeformed(folder, model, beam_names, outlines):
     if not any(v is not None for v in outlines.values()):
         return
     mesh = surface_mesh(fields, model.degree, beam_names, outlines)
-    if len(mesh[0]):
-        write_unstructured_vtu(path, *mesh)
+    if len(mesh.points):
+        write_grid(path, surface_grid(mesh))
 
 
 def picture_plan(results, animate=False):
@@ -173,29 +173,53 @@ def _frames(folder):
     return [(t, surfaces.get(t), line) for t, line in lines]
 
 
-def _line_beams(line, surface):
-    """The centre line cells of beams that the surface leaves out (no section outline)."""
-    drawn = set() if surface is None else set(np.unique(surface.point_data["beam"]).tolist())
-    beam = np.asarray(line.point_data["beam"]).astype(int)
-    first = line.cell_connectivity.reshape(-1, 2)[:, 0]
-    keep = ~np.isin(beam[first], list(drawn))
-    return line.extract_cells(np.flatnonzero(keep)) if keep.any() else None
+def _line_beams(pv, line, surface):
+    """The centre line cells of beams that the surface leaves out (no section outline), as
+    polylines through the nodes of each cell (a VTK Lagrange curve lists its two ends first,
+    then the interior nodes), with the point arrays."""
+    drawn = set() if surface is None else set(np.unique(surface.cell_data["beam"]).tolist())
+    keep = ~np.isin(np.asarray(line.cell_data["beam"]), list(drawn))
+    if not keep.any():
+        return None
+    conn, offsets = np.asarray(line.cell_connectivity), np.asarray(line.cell_offsets)
+    lines = []
+    for c in np.flatnonzero(keep):
+        ids = conn[offsets[c] : offsets[c + 1]]
+        path = np.r_[ids[0], ids[2:], ids[1]] if len(ids) > 2 else ids
+        lines.append(np.r_[len(path), path])
+    poly = pv.PolyData(np.asarray(line.points), lines=np.concatenate(lines))
+    for name in line.point_data:
+        poly.point_data[name] = line.point_data[name]
+    return poly
 
 
 def _load(pv, frame):
     """(deformed surface or None, deformed centre line or None, reference centre line)."""
     _, surface_file, line_file = frame
-    surface = pv.read(surface_file) if surface_file else None
-    line = _line_beams(pv.read(line_file), surface)
+    surface = _single(pv, pv.read(surface_file)) if surface_file else None
+    line = _line_beams(pv, _single(pv, pv.read(line_file)), surface)
     reference = None
     if line is not None:
-        reference = line.copy()
-        reference.points = np.asarray(line.point_data["X"])
-        line.point_data["|u|"] = np.linalg.norm(line.point_data["u"], axis=1)
+        if "X" in line.point_data:
+            reference = line.copy()
+            reference.points = np.asarray(line.point_data["X"])
+        line.point_data["|u|"] = _magnitude(line, "u")
     if surface is not None:
         surface = surface.extract_surface().compute_normals(feature_angle=40.0, split_vertices=True)
-        surface.point_data["|u|"] = np.linalg.norm(surface.point_data["u"], axis=1)
+        surface.point_data["|u|"] = _magnitude(surface, "u")
     return surface, line, reference
+
+
+def _single(pv, data):
+    """One grid of a frame (the pieces of a parallel run's .pvtu come as one already)."""
+    return data.combine() if isinstance(data, pv.MultiBlock) else data
+
+
+def _magnitude(mesh, name):
+    """|a| of the point array ``name``, zero if the frames do not carry it."""
+    if name not in mesh.point_data:
+        return np.zeros(mesh.n_points)
+    return np.linalg.norm(mesh.point_data[name], axis=1)
 
 
 def _camera(plotter, bounds):

@@ -2,8 +2,12 @@
 
 Each rank evaluates the named points whose vertex it owns, on one adjacent local cell, with
 the shared section expression at both cell ends (ξ = 0 and 1); the answers are allgathered so
-that every rank returns the same dictionary.
+that every rank returns the same dictionary. The lookup of the points (which cell, which end,
+on which rank) is made once per model and list of names and cached on the model: a transient
+asks for the same probes at every step.
 """
+
+import weakref
 
 import numpy as np
 
@@ -11,6 +15,7 @@ from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_ro
 from ._sections import evaluate
 
 CELL_ENDS = np.array([[0.0], [1.0]])
+_plans = weakref.WeakKeyDictionary()  # model -> {names: (found, cells)}
 
 
 def _locate(model, name):
@@ -36,6 +41,20 @@ def _locate(model, name):
     if node not in ends:
         raise RuntimeError(f"vertex of point {name!r} is not an end of its cell {c}")
     return c, int(np.flatnonzero(ends == node)[0])
+
+
+def _plan(model, names):
+    """[(name, end)] of the named points this rank evaluates and their cells (int32), cached
+    per model and tuple of names (the mesh of a model does not change)."""
+    per_model = _plans.setdefault(model, {})
+    key = tuple(names)
+    if key not in per_model:
+        model.mesh.mesh.topology.create_connectivity(0, 1)
+        located = [(n, _locate(model, n)) for n in dict.fromkeys(names)]
+        located = [(n, loc) for n, loc in located if loc is not None]
+        cells = np.array([c for _, (c, _) in located], dtype=np.int32)
+        per_model[key] = ([(n, end) for n, (_, end) in located], cells)
+    return per_model[key]
 
 
 def _point_values(finite, v):
@@ -85,17 +104,14 @@ def evaluate_points(model, names=None, recover=True):
     if unknown:
         raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
     model.sync()  # derived fields (the condensed model integrates its displacement)
-    model.mesh.mesh.topology.create_connectivity(0, 1)
-
-    found = [(n, _locate(model, n)) for n in names]
-    found = [(n, loc) for n, loc in found if loc is not None]
-    values = evaluate(model, CELL_ENDS, [c for _, (c, _) in found], recover)
+    found, cells = _plan(model, names)
+    values = evaluate(model, CELL_ENDS, cells, recover)
     local = {}
-    for i, (n, (_, end)) in enumerate(found):
+    for i, (n, end) in enumerate(found):
         local[n] = _point_values(model.kin.finite, {k: a[i, end] for k, a in values.items()})
 
     result = {}
-    for part in comm.allgather(local):
+    for part in comm.allgather(local) if comm.size > 1 else [local]:
         for n, v in part.items():
             result.setdefault(n, v)
     missing = [n for n in names if n not in result]

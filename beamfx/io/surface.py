@@ -22,19 +22,19 @@ a ``general`` section (stiffnesses only) has no outline and is left out of the s
 
 Point data of the surface: ``u`` the displacement of the centre line at the section's sample
 (global axes; points of one section share it), ``N`` and ``M`` the section force and moment
-(section axes), ``beam`` the beam index. Cells: VTK_QUAD along the beam and VTK_POLYGON (or,
-for tubes, VTK_QUAD rings) as end caps.
+(section axes). Cell data: ``cell`` the input index of the element a face belongs to and
+``beam`` its beam index. Cells: VTK_QUAD along the beam and VTK_POLYGON (or, for tubes,
+VTK_QUAD rings) as end caps, at the first and last element of each beam only, so that the
+pieces of several ranks (each its own elements) together make the surface of one rank.
 """
 
-import os
+from typing import NamedTuple
 
 import numpy as np
-from mpi4py import MPI
 
 from ._sections import lagrange_matrix
-from .paraview import PvdSeries, write_unstructured_vtu
+from .vtkfiles import VTK_POLYGON, VTK_QUAD
 
-VTK_POLYGON, VTK_QUAD = 7, 9
 CIRCLE_SEGMENTS = 32
 SAMPLE_ARRAYS = ("u", "N", "M")
 
@@ -88,7 +88,8 @@ def refine(fields, degree, subdivisions=4):
     """Samples of the centre line: each element's k + 1 nodes refined to ``subdivisions`` + 1.
 
     Args:
-        fields: the rank-0 dict of :func:`~beamfx.io.fields.nodal_fields`.
+        fields: the dict of :func:`~beamfx.io.fields.local_fields` or
+            :func:`~beamfx.io.fields.nodal_fields` (whole elements, each in order).
         degree: the element degree k.
         subdivisions: intervals per element (its samples are equally spaced in ξ).
 
@@ -109,127 +110,156 @@ def refine(fields, degree, subdivisions=4):
     axes = np.stack([per_element(fields[e]) for e in ("e1", "e2", "e3")], axis=-1)
     U, _, Vt = np.linalg.svd(axes)  # nearest rotation: U Vᵀ (the sign is safe: axes ≈ R)
     out["axes"] = U @ Vt
-    out["beam"] = np.asarray(fields["beam"]).reshape(n_el, k + 1)[:, 0].astype(np.int64)
+    beam = np.asarray(fields["beam"])
+    out["beam"] = (beam if len(beam) == n_el else beam.reshape(n_el, k + 1)[:, 0]).astype(np.int64)
     return out
 
 
-def _caps(loops, first, last, n_per_ring):
-    """End cap cells of one beam: ``first``/``last`` are the ring offsets of its ends."""
-    cells = []
-    for ring, flip in ((first, True), (last, False)):
-        if len(loops) == 1:
-            ids = ring + np.arange(n_per_ring)
-            cells.append(ids[::-1] if flip else ids)
-        elif len(loops) == 2 and len(loops[0]) == len(loops[1]):
-            n = len(loops[0])
-            outer = ring + np.arange(n)
-            inner = ring + n + np.arange(n)[::-1]  # inner loop runs clockwise: re-align
-            for j in range(n):
-                q = np.array([outer[j], outer[(j + 1) % n], inner[(j + 1) % n], inner[j]])
-                cells.append(q[::-1] if flip else q)
-    return cells
+class SurfaceMesh(NamedTuple):
+    """The swept surface as arrays (see the module docstring)."""
+
+    points: np.ndarray  # (n, 3)
+    connectivity: np.ndarray  # point indices of all cells, one after another
+    offsets: np.ndarray  # (cells + 1,): cell i is connectivity[offsets[i]:offsets[i + 1]]
+    types: np.ndarray  # (cells,) VTK cell types
+    point_data: dict  # u, N, M: (n, 3)
+    cell_data: dict  # cell: input index of the face's element, beam: its beam index (cells,)
+
+    def cells(self):
+        """The cells as a list of point index arrays."""
+        return np.split(self.connectivity, self.offsets[1:-1]) if len(self.types) else []
 
 
-def surface_mesh(fields, degree, beam_names, outlines, subdivisions=4):
-    """Points, cells and point data of the swept section surface (rank-0 NumPy).
+def _cap(loops, ring, flip):
+    """End cap cells of the section ring starting at point ``ring``: one polygon, or for a
+    tube a ring of quads between the outer and (clockwise) inner loop; ``flip`` reverses
+    them (the start of a beam faces backwards)."""
+    if len(loops) == 1:
+        ids = ring + np.arange(len(loops[0]))
+        return [ids[::-1] if flip else ids]
+    if len(loops) == 2 and len(loops[0]) == len(loops[1]):
+        n = len(loops[0])
+        j = np.arange(n)
+        outer, inner = ring + j, ring + n + j[::-1]  # inner loop runs clockwise: re-align
+        quads = np.stack([outer, np.roll(outer, -1), np.roll(inner, -1), inner], axis=1)
+        return list(quads[:, ::-1] if flip else quads)
+    return []
+
+
+def _sides(loops, n_el, samples, ring, base):
+    """Quads along the beam of ``n_el`` elements whose points start at ``base`` (each element
+    ``samples`` rings of ``ring`` points), element by element: (quads (m, 4), element (m,))."""
+    quads = []
+    e = np.arange(n_el)[:, None, None]
+    i = np.arange(samples - 1)[None, :, None]
+    start = 0
+    for lp in loops:
+        j = np.arange(len(lp))[None, None, :]
+        a = base + (e * samples + i) * ring + start
+        c = a + ring
+        jn = (j + 1) % len(lp)
+        q = np.stack(np.broadcast_arrays(a + j, a + jn, c + jn, c + j), axis=-1)
+        quads.append(q.reshape(n_el, -1, 4))
+        start += len(lp)
+    q = np.concatenate(quads, axis=1)
+    return q.reshape(-1, 4), np.repeat(np.arange(n_el), q.shape[1])
+
+
+def _element_ends(cell, s_beam, ends):
+    """Booleans (first, last) per element: does it start or end its beam?"""
+    n_el = len(s_beam)
+    if ends is None:  # the first and last element of each beam among these fields
+        first, last = {}, {}
+        for e, b in enumerate(s_beam.tolist()):
+            first.setdefault(b, e)
+            last[b] = e
+        return np.isin(np.arange(n_el), list(first.values())), np.isin(
+            np.arange(n_el), list(last.values())
+        )
+    lo, hi = (np.asarray(a) for a in ends)
+    return cell == lo[s_beam], cell == hi[s_beam]
+
+
+def surface_mesh(fields, degree, beam_names, outlines, subdivisions=4, ends=None):
+    """The swept section surface of the elements in ``fields`` (NumPy, no MPI).
 
     Args:
-        fields: the rank-0 dict of :func:`~beamfx.io.fields.nodal_fields`.
+        fields: the dict of :func:`~beamfx.io.fields.local_fields` (one rank's elements) or
+            :func:`~beamfx.io.fields.nodal_fields` (all of them).
         degree: the element degree k.
         beam_names: names of the beams in beam-index order (``fields["beam"]``).
         outlines: ``{beam name: list of (n, 2) loops (y, z)}``; beams missing or None are
             left out.
         subdivisions: intervals per element along the centre line.
+        ends: (first, last) input cell index of every beam (by beam index), where the end
+            caps go; None: the first and last element of each beam in ``fields``.
 
     Returns:
-        (points (n, 3), cells (list of index arrays), cell types (m,), point data dict).
+        :class:`SurfaceMesh`.
     """
     s = refine(fields, degree, subdivisions)
-    points, cells, types, data = [], [], [], {name: [] for name in (*SAMPLE_ARRAYS, "beam")}
+    cell = np.asarray(fields.get("cell", np.arange(len(s["beam"]))), dtype=np.int64)
+    first, last = _element_ends(cell, s["beam"], ends)
+    samples = subdivisions + 1
+    points, cells, sizes, types, element = [], [], [], [], []
+    data = {name: [] for name in SAMPLE_ARRAYS}
     n_points = 0
     for b, name in enumerate(beam_names):
         loops = outlines.get(name)
-        if loops is None:
+        elements = np.flatnonzero(s["beam"] == b)
+        if loops is None or not len(elements):
             continue
         loops = [np.asarray(lp, float).reshape(-1, 2) for lp in loops]
         yz = np.concatenate(loops)  # one ring = all loops of a section
         ring = len(yz)
-        elements = np.flatnonzero(s["beam"] == b)
-        first_ring = n_points
-        for e in elements:
-            x, axes = s["x"][e], s["axes"][e]  # (S, 3), (S, 3, 3)
-            pts = x[:, None, :] + yz[None, :, 0, None] * axes[:, None, :, 1]
-            pts = pts + yz[None, :, 1, None] * axes[:, None, :, 2]
-            points.append(pts.reshape(-1, 3))
-            for key in SAMPLE_ARRAYS:
-                data[key].append(np.repeat(s[key][e], ring, axis=0))
-            data["beam"].append(np.full(len(x) * ring, b, np.int64))
-            start = 0
-            for lp in loops:
-                n = len(lp)
-                j = np.arange(n)
-                for i in range(len(x) - 1):
-                    a = n_points + i * ring + start
-                    c = a + ring
-                    quads = np.stack([a + j, a + (j + 1) % n, c + (j + 1) % n, c + j], axis=1)
-                    cells.extend(quads)
-                    types.extend([VTK_QUAD] * n)
-                start += n
-            last_ring = n_points + (len(x) - 1) * ring
-            n_points += len(x) * ring
-        if len(elements):
-            caps = _caps(loops, first_ring, last_ring, ring)
-            cells.extend(caps)
-            types.extend(VTK_QUAD if len(c) == 4 and len(loops) == 2 else VTK_POLYGON for c in caps)
+        x, axes = s["x"][elements], s["axes"][elements]  # (E, S, 3), (E, S, 3, 3)
+        pts = x[:, :, None, :] + yz[None, None, :, 0, None] * axes[:, :, None, :, 1]
+        points.append((pts + yz[None, None, :, 1, None] * axes[:, :, None, :, 2]).reshape(-1, 3))
+        for key in SAMPLE_ARRAYS:
+            data[key].append(np.repeat(s[key][elements].reshape(-1, 3), ring, axis=0))
+        quads, owner = _sides(loops, len(elements), samples, ring, n_points)
+        cells.append(quads.ravel())
+        sizes.append(np.full(len(quads), 4))
+        types.append(np.full(len(quads), VTK_QUAD))
+        element.append(elements[owner])
+        cap_type = VTK_QUAD if len(loops) == 2 else VTK_POLYGON
+        for flag, flip, shift in ((first, True, 0), (last, False, (samples - 1) * ring)):
+            for local in np.flatnonzero(flag[elements]):
+                caps = _cap(loops, n_points + local * samples * ring + shift, flip)
+                cells.extend(caps)
+                sizes.append([len(c) for c in caps])
+                types.append([cap_type] * len(caps))
+                element.append(np.full(len(caps), elements[local]))
+        n_points += len(elements) * samples * ring
     if not points:
-        return np.zeros((0, 3)), [], np.zeros(0, np.uint8), {}
-    data = {k: np.concatenate(v) for k, v in data.items()}
-    return np.concatenate(points), cells, np.asarray(types, np.uint8), data
+        none = np.zeros(0, np.int64)
+        empty = {k: np.zeros((0, 3)) for k in SAMPLE_ARRAYS}
+        return SurfaceMesh(
+            np.zeros((0, 3)),
+            none,
+            np.zeros(1, np.int64),
+            none.astype(np.uint8),
+            empty,
+            {"cell": none, "beam": none},
+        )
+    element = np.concatenate(element).astype(np.int64)
+    sizes = np.concatenate(sizes)
+    return SurfaceMesh(
+        np.concatenate(points),
+        np.concatenate(cells).astype(np.int64),
+        np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+        np.concatenate(types).astype(np.uint8),
+        {k: np.concatenate(v) for k, v in data.items()},
+        {"cell": cell[element], "beam": s["beam"][element]},
+    )
 
 
-class SurfaceSeries:
-    """``surface.pvd`` and one ``surface_NNNN.vtu`` per step; rank 0 writes.
+def surface_grid(mesh, arrays=SAMPLE_ARRAYS):
+    """The VTK grid of a :class:`SurfaceMesh`: point data ``arrays`` (of u, N, M), cell data
+    ``cell`` and ``beam``."""
+    from .vtkfiles import unstructured_grid
 
-    Args:
-        path: the ".pvd" file; the .vtu files go beside it.
-        degree: the element degree k of the model.
-        beam_names: beam names in beam-index order.
-        outlines: ``{beam name: loops}``, e.g. from :func:`model_outlines`.
-        subdivisions: intervals per element along the centre line.
-        comm: the communicator whose rank 0 writes.
-    """
-
-    def __init__(self, path, degree, beam_names, outlines, subdivisions=4, comm=MPI.COMM_WORLD):
-        self.pvd = PvdSeries(path, comm)
-        self.degree, self.beam_names, self.outlines = degree, list(beam_names), outlines
-        self.subdivisions, self.comm = subdivisions, comm
-
-    def add(self, step, time, fields):
-        """Write the surface of ``fields`` (from ``nodal_fields``) as step number ``step``."""
-        if self.comm.rank != 0:
-            return
-        stem = os.path.splitext(self.pvd.path)[0]
-        vtu = f"{stem}_{step:04d}.vtu"
-        mesh = surface_mesh(fields, self.degree, self.beam_names, self.outlines, self.subdivisions)
-        if len(mesh[0]) == 0:  # no beam has a drawable section (all "general")
-            return
-        write_unstructured_vtu(vtu, *mesh)
-        self.pvd.add(time, vtu)
-
-
-def write_paraview_script(folder, comm=MPI.COMM_WORLD):
-    """Copy ``open_in_paraview.py`` (a pvpython script showing the results) into ``folder``,
-    with that folder's absolute path as the fallback for ``paraview --script`` (no __file__)."""
-    if comm.rank != 0:
-        return
-    here = os.path.dirname(os.path.abspath(__file__))
-    source = os.path.join(here, "pvscripts", "open_in_paraview.py")
-    target = os.path.join(os.fspath(folder), "open_in_paraview.py")
-    with open(source, encoding="utf-8") as f:
-        text = f.read()
-    folder = os.path.abspath(os.fspath(folder))
-    text = text.replace("\nWRITTEN_TO = None\n", f"\nWRITTEN_TO = {folder!r}\n", 1)
-    tmp = f"{target}.tmp{os.getpid()}"
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(text)
-    os.replace(tmp, target)
+    point_data = {k: mesh.point_data[k] for k in arrays if k in mesh.point_data}
+    return unstructured_grid(
+        mesh.points, mesh.connectivity, mesh.offsets, mesh.types, point_data, mesh.cell_data
+    )

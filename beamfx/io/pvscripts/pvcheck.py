@@ -5,11 +5,12 @@ Runs in ParaView's own Python and imports nothing from beamfx (only its sibling
 
     xvfb-run -a pvpython pvcheck.py RESULTS_DIR --png out.png [--tip X Y Z] [--tol T]
 
-Opens ``deformed.pvd``, ``deformed.xdmf`` and ``surface.pvd`` at the last time, checks the
-point arrays each must carry and that the deformed centre line has a point within ``tol`` of
-``tip`` (if given) and the surface one within ``tol`` plus half the section's size; renders
-the picture of ``open_in_paraview.py`` to ``--png``. Prints one JSON line with what it found;
-exit status 1 if a check failed.
+Opens ``deformed.pvd`` (``.vtu`` or, from several ranks, ``.pvtu`` frames of Lagrange curves),
+and ``surface.pvd`` and ``deformed.xdmf`` where present, at the last time; checks the point
+arrays each must carry and that the deformed centre line has a point within ``tol`` of ``tip``
+(if given; the XDMF holds the reference line, so X + u there) and the surface one within
+``tol`` plus half the section's size; renders the picture of ``open_in_paraview.py`` to
+``--png``. Prints one JSON line with what it found; exit status 1 if a check failed.
 """
 
 import argparse
@@ -51,7 +52,11 @@ def check(folder, tip=None, tol=0.5):
     """Summary dict of the three files and a list of failed checks."""
     found, failed = {}, []
     for name, required in REQUIRED.items():
+        if name != "deformed.pvd" and not os.path.exists(os.path.join(folder, name)):
+            continue
         points, arrays, times = read(os.path.join(folder, name))
+        if name.endswith(".xdmf") and "u" in arrays:  # reference geometry + displacement
+            points = points + arrays["u"]
         entry = {
             "points": len(points),
             "times": len(times),
@@ -71,7 +76,7 @@ def check(folder, tip=None, tol=0.5):
             if gap > allowed:
                 failed.append(f"{name}: no point within {allowed:.3g} of the tip {tip} ({gap:.3g})")
         found[name] = entry
-    n = {found[k]["times"] for k in REQUIRED}
+    n = {entry["times"] for entry in found.values()}
     if len(n) != 1:
         failed.append(f"the files hold different numbers of time steps: {n}")
     return found, failed
