@@ -51,14 +51,14 @@ ELEMENTS, DEGREE = 8, 3
 TOL_POSITION, TOL_MOMENT = 1e-5, 1e-5
 
 
-def rollup_model(turns):
+def rollup_model(turns, comm=comm):
     M = turns * 2 * np.pi * EI / L
     spec = Model(
         beams=(Beam("b", Line((0, 0, 0), (L, 0, 0)), SECTION, ELEMENTS, DEGREE),),
         supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
         point_loads=(PointLoad("b:end", moment=(0, -M, 0)),),
     )
-    return BeamModel(spec), M
+    return BeamModel(spec, comm), M
 
 
 def exact_tip(phi):

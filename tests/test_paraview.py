@@ -190,3 +190,37 @@ def test_paraview_reads_transient_modal_and_buckling(tmp_path, analysis, keys):
     assert files["surface.pvd"]["points"] > files["deformed.pvd"]["points"]
     image = files["png"]
     assert image["colours"] > 50 and 0.001 < image["foreground"] < 0.5
+
+
+@pytest.mark.skipif(PVPYTHON is None, reason="pvpython not found (apt: python3-paraview)")
+@pytest.mark.skipif(
+    not os.environ.get("DISPLAY") and XVFB is None,
+    reason="no DISPLAY and no Xvfb (apt: xvfb) for ParaView's X-only rendering",
+)
+def test_paraview_reads_every_format(tmp_path):
+    """The centre line, the surface and the XDMF (not a default) of the half-circle roll-up,
+    written by the frame writer: ParaView finds the exact tip (0, 0, 2L/π) in each."""
+    from dataclasses import replace
+
+    import numpy as np
+    from test_io import L, SECTION, TOL_POSITION, rollup_model
+
+    from beamfx.analyses.static import solve_static
+    from beamfx.io import FrameWriter, OutputSettings
+
+    folder = Path(comm.bcast(str(tmp_path), root=0))
+    model, _ = rollup_model(0.5)
+    steps = 4
+    section = replace(SECTION, shape=("rectangle", 0.2, 0.1))
+    beams = tuple(replace(b, section=section) for b in model.spec.beams)
+    settings = OutputSettings(formats=("vtu", "surface", "xdmf"))
+    writer = FrameWriter(folder, model, settings, beams, comm)
+    solve_static(model, steps=steps, on_step=lambda s: writer.write(s.step, s.load_factor))
+    writer.close()
+    report, error = _pvcheck(folder, [0.0, 0.0, 2 * L / np.pi])
+    assert error is None, error
+    assert report["ok"], report["failed"]
+    files = report["files"]
+    assert set(files) == {"deformed.pvd", "surface.pvd", "deformed.xdmf", "png"}
+    assert {f["times"] for f in files.values() if "times" in f} == {steps}
+    assert files["deformed.pvd"]["distance_to_tip"] < TOL_POSITION * L

@@ -153,6 +153,7 @@ def _stand_in(grid):
 
     one = vtkUnstructuredGrid()
     points = grid.GetPoints().NewInstance()
+    points.SetDataType(grid.GetPoints().GetDataType())
     points.SetNumberOfPoints(1)
     points.SetPoint(0, 0.0, 0.0, 0.0)
     one.SetPoints(points)

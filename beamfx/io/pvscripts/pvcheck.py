@@ -34,18 +34,37 @@ REQUIRED = {
 
 
 def read(path):
-    """The dataset of ``path`` at its last time: (points (n, 3), {array: values}, times)."""
+    """The dataset of ``path`` at its last time: (points (n, 3), {array: values}, times).
+
+    A composite dataset (DOLFINx's XDMF: the mesh, then one grid per function) gives the
+    points of its first block and the point arrays of all blocks of as many points."""
     reader = pvs.OpenDataFile(path)
     times = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
-    merged = pvs.MergeBlocks(Input=reader)
-    merged.UpdatePipeline(times[-1])
-    data = servermanager.Fetch(merged)
-    points = vtk_to_numpy(data.GetPoints().GetData())
-    pd = data.GetPointData()
-    arrays = {
-        pd.GetArrayName(i): vtk_to_numpy(pd.GetArray(i)) for i in range(pd.GetNumberOfArrays())
-    }
+    reader.UpdatePipeline(times[-1])
+    blocks = _datasets(servermanager.Fetch(reader))
+    points = vtk_to_numpy(blocks[0].GetPoints().GetData())
+    arrays = {}
+    for block in blocks:
+        pd = block.GetPointData()
+        if block.GetNumberOfPoints() != len(points):
+            continue
+        for i in range(pd.GetNumberOfArrays()):
+            arrays.setdefault(pd.GetArrayName(i), vtk_to_numpy(pd.GetArray(i)))
     return points, arrays, times
+
+
+def _datasets(data):
+    """The leaf datasets (with points) of a composite dataset, or ``[data]``."""
+    if not data.IsA("vtkCompositeDataSet"):
+        return [data]
+    out, it = [], data.NewIterator()
+    it.InitTraversal()
+    while not it.IsDoneWithTraversal():
+        leaf = it.GetCurrentDataObject()
+        if leaf is not None and leaf.GetNumberOfPoints():
+            out.append(leaf)
+        it.GoToNextItem()
+    return out
 
 
 def check(folder, tip=None, tol=0.5):
