@@ -126,7 +126,9 @@ def render_in_child(child, job, files, log=print, timeout=900):
     plan = [{"file": f} for f in files]
     if find_spec("pyvista") is None:
         return _skip(plan, "pyvista is not installed (pip install pyvista)", log)
-    env = dict(os.environ)
+    # without the variables of mpirun: the child (which imports mpi4py) is a process of its
+    # own, and MPI_Init under a rank's settings aborts it
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
     env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     try:
         done = subprocess.run(
