@@ -203,7 +203,7 @@ def test_paraview_reads_every_format(tmp_path):
     from dataclasses import replace
 
     import numpy as np
-    from test_io import L, SECTION, TOL_POSITION, rollup_model
+    from test_io import SECTION, TOL_POSITION, L, rollup_model
 
     from beamfx.analyses.static import solve_static
     from beamfx.io import FrameWriter, OutputSettings
