@@ -144,12 +144,13 @@ class FrameWriter:
         self.series, self.xdmf, self._ends = {}, None, None
         prepare_output(settings)
         if set(settings.formats) & set(VTK_FORMATS):
-            from .vtkfiles import VtkSeries
+            from .vtkfiles import GridBuffer, VtkSeries
 
             if "vtu" in settings.formats:
                 self.series["deformed"] = VtkSeries(self.folder, "deformed", self.comm)
             if "surface" in settings.formats and any(v is not None for v in self.outlines.values()):
                 self.series["surface"] = VtkSeries(self.folder, "surface", self.comm)
+            self.grids = {name: GridBuffer() for name in self.series}
         if "xdmf" in settings.formats:
             from .xdmf import XdmfSeries
 
@@ -178,7 +179,9 @@ class FrameWriter:
         if "deformed" in self.series:
             point_data = {name: fields[name] for name in arrays}
             points = fields["X"] + fields["u"]
-            grid = lagrange_line_grid(points, self.model.degree, point_data, cell_data)
+            grid = lagrange_line_grid(
+                points, self.model.degree, point_data, cell_data, self.grids["deformed"]
+            )
             self.series["deformed"].write(step, time, grid)
         if "surface" in self.series:
             self.series["surface"].write(step, time, self._surface(fields, arrays))
@@ -198,7 +201,7 @@ class FrameWriter:
             np.maximum.at(last, fields["beam"], fields["cell"])
             self._ends = (self.comm.allreduce(first, MPI.MIN), self.comm.allreduce(last, MPI.MAX))
         mesh = surface_mesh(fields, self.model.degree, self.names, self.outlines, ends=self._ends)
-        return surface_grid(mesh, arrays)
+        return surface_grid(mesh, arrays, self.grids["surface"])
 
     def resume(self, t_max):
         """Keep the frames up to ``t_max`` of an earlier run in the folder (a restart) and

@@ -254,12 +254,13 @@ def surface_mesh(fields, degree, beam_names, outlines, subdivisions=4, ends=None
     )
 
 
-def surface_grid(mesh, arrays=SAMPLE_ARRAYS):
+def surface_grid(mesh, arrays=SAMPLE_ARRAYS, build=None):
     """The VTK grid of a :class:`SurfaceMesh`: point data ``arrays`` (of u, N, M), cell data
-    ``cell`` and ``beam``."""
+    ``cell`` and ``beam``; made by ``build`` (default
+    :func:`~beamfx.io.vtkfiles.unstructured_grid`, or a :class:`~beamfx.io.vtkfiles.GridBuffer`)."""
     from .vtkfiles import unstructured_grid
 
     point_data = {k: mesh.point_data[k] for k in arrays if k in mesh.point_data}
-    return unstructured_grid(
+    return (build or unstructured_grid)(
         mesh.points, mesh.connectivity, mesh.offsets, mesh.types, point_data, mesh.cell_data
     )
