@@ -15,6 +15,7 @@ import io
 import itertools
 import json
 import os
+import sys
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -334,6 +335,16 @@ def test_output_policy_every_times_and_last():
     policy.resume(0.5)  # restarted at 0.5: 0.25 is done, 0.55 still to come
     assert not policy.want(6, 0.52) and policy.want(7, 0.6)
     assert default_every("transient", 1440) == 7 and default_every("static", 40) == 1
+
+
+def test_missing_vtk_is_reported_before_the_solve(monkeypatch):
+    from beamfx.io.output import prepare_output
+    from beamfx.io.vtkfiles import OutputUnavailable
+
+    monkeypatch.setitem(sys.modules, "vtkmodules.vtkIOXML", None)  # import -> ImportError
+    with pytest.raises(OutputUnavailable, match="pip install vtk"):
+        prepare_output(OutputSettings())
+    prepare_output(OutputSettings(formats=("xdmf",)))  # DOLFINx's own writer: no VTK needed
 
 
 def test_output_settings_problems():

@@ -84,7 +84,8 @@ def prepare_output(settings):
     imported now, before DOLFINx, see :func:`beamfx.io.vtkfiles.import_vtk`).
 
     Raises:
-        RuntimeError: if a VTK format is asked for and VTK is missing.
+        beamfx.io.vtkfiles.OutputUnavailable: (an OSError) if a VTK format is asked for and
+            VTK is missing.
     """
     if set(settings.formats) & set(VTK_FORMATS):
         from .vtkfiles import import_vtk

@@ -35,18 +35,22 @@ HEAD = '<?xml version="1.0"?>\n<VTKFile type="Collection" version="1.0" byte_ord
 TAIL = "</Collection>\n</VTKFile>\n"
 
 
+class OutputUnavailable(OSError):
+    """The frames cannot be written (a library is missing): raised before the solve."""
+
+
 def import_vtk():
     """Import the VTK modules the writers need (call it before DOLFINx is imported).
 
     Raises:
-        RuntimeError: if VTK is not installed, naming the package to install.
+        OutputUnavailable: if VTK is not installed, naming the package to install.
     """
     try:
         import vtkmodules.vtkCommonCore
         import vtkmodules.vtkCommonDataModel
         import vtkmodules.vtkIOXML  # noqa: F401
     except ImportError as e:
-        raise RuntimeError(
+        raise OutputUnavailable(
             f"the ParaView output needs VTK's Python wheel ({e}): pip install vtk, or leave "
             'out the VTK formats ([output] formats = ["xdmf"] or [])'
         ) from None
@@ -367,6 +371,7 @@ def _line(time, file):
 
 __all__ = [
     "GridBuffer",
+    "OutputUnavailable",
     "PvdIndex",
     "VtkSeries",
     "import_vtk",
