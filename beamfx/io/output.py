@@ -4,7 +4,8 @@
 :class:`FrameWriter` writes a frame of the current state when asked; :meth:`FrameWriter.want`
 is the every/times policy. Each frame costs the same whatever the number of frames before it:
 data files are written by VTK, one piece per rank of the cells it owns (nothing is gathered
-to rank 0), and the time-series indices grow by one line (:mod:`beamfx.io.vtkfiles`).
+to rank 0), and the time-series indices grow by one line (:mod:`beamfx.io.vtkfiles`,
+:mod:`beamfx.io.series`).
 
 Formats:
 
@@ -145,7 +146,8 @@ class FrameWriter:
         self.series, self.xdmf, self._ends = {}, None, None
         prepare_output(settings)
         if set(settings.formats) & set(VTK_FORMATS):
-            from .vtkfiles import GridBuffer, VtkSeries
+            from .series import VtkSeries
+            from .vtkfiles import GridBuffer
 
             if "vtu" in settings.formats:
                 self.series["deformed"] = VtkSeries(self.folder, "deformed", self.comm)
@@ -174,6 +176,9 @@ class FrameWriter:
         from .fields import local_fields
         from .vtkfiles import lagrange_line_grid
 
+        if not self.series and self.xdmf is None:  # formats = []: nothing to write
+            self.policy.record(step, time)
+            return
         fields = local_fields(self.model)
         arrays = self.settings.fields
         cell_data = {"cell": fields["cell"], "beam": fields["beam"]}

@@ -1,4 +1,4 @@
-"""VTK XML files through VTK's own writers, and the PVD index of a time series.
+"""VTK XML files through VTK's own writers.
 
 Data files (``.vtu`` and the ``.pvtu`` summary of a parallel frame) are written by VTK
 (``vtkXMLUnstructuredGridWriter``, ``vtkXMLPUnstructuredGridWriter``): binary, compressed,
@@ -6,33 +6,28 @@ appended, 64-bit headers, to a temporary name and then renamed, so a reader neve
 file. VTK makes each file in memory (2.5 times faster than its own file output for a small
 frame). Compression is LZ4, not zlib: on a frame of real results (48 kB of doubles, most of
 them incompressible) zlib at level 1 took 0.59 ms and saved 28 %, LZ4 0.07 ms and saved 24 %
-(no compression: 0.06 ms); VTK ≥ 8.2 and ParaView ≥ 5.6 read both. Under MPI every
+(no compression: 0.06 ms); ParaView 5.11 (Debian 12) and the vtk wheel read it. Under MPI every
 rank writes its own piece ``name_NNNN_R.vtu`` (the cells it owns) and rank 0 the summary
 ``name_NNNN.pvtu``; nothing is gathered. Without an MPI controller (the pip wheel has none)
 VTK's parallel writer lists only the pieces it wrote itself, so once per series rank 0 lets
 it write the summary of all ranks' pieces from a one-point stand-in of its own piece in a
 scratch folder; every frame's summary is that file with the frame's piece names.
 
-The PVD time-series index is the only XML written by hand here: VTK's wheel has no PVD
-writer, and rewriting a whole index after every frame costs in proportion to the frames
-written (the old writers spent 6 s of a 10 s run that way). :class:`PvdIndex` appends one
-``<DataSet>`` line per frame in place of the closing tags, so a frame costs the same at the
-10th and the 10 000th frame and the file is valid after each one.
+The time series (``.pvd`` index and frame files) are in :mod:`beamfx.io.series`.
 
-Import :func:`import_vtk` before DOLFINx in one process (see docs: the VTK wheel and
-DOLFINx's RTLD_GLOBAL libstdc++ clash).
+Import :func:`import_vtk` before DOLFINx in one process: DOLFINx loads its libraries with
+RTLD_GLOBAL, and the VTK wheel's libstdc++ pieces then clash with Debian's. With DOLFINx first,
+writing and reading these files worked in our tests but rendering aborted (std::bad_alloc);
+with these three VTK modules first, rendering in the same process works too. They add about
+0.1 s to the start of a process (median of 8: ``import dolfinx`` 0.69 s, with them 0.79 s).
 """
 
 import os
 import tempfile
-import xml.etree.ElementTree as ET
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 VTK_VERTEX, VTK_LINE, VTK_POLYGON, VTK_QUAD, VTK_LAGRANGE_CURVE = 1, 3, 7, 9, 68
-HEAD = '<?xml version="1.0"?>\n<VTKFile type="Collection" version="1.0" byte_order="LittleEndian">\n<Collection>\n'
-TAIL = "</Collection>\n</VTKFile>\n"
 
 
 class OutputUnavailable(OSError):
@@ -258,125 +253,11 @@ def write_summary(path, template):
     os.replace(tmp, path)
 
 
-def piece_names(path):
-    """Files of the pieces a ``.pvtu`` lists (beside it), read from the file."""
-    folder = os.path.dirname(os.fspath(path))
-    root = ET.parse(path).getroot()
-    return [os.path.join(folder, p.get("Source")) for p in root.iter("Piece")]
-
-
-class PvdIndex:
-    """A ParaView collection (``.pvd``) appended one ``<DataSet>`` line per frame (rank 0).
-
-    Args:
-        path: the ``.pvd`` file.
-    """
-
-    def __init__(self, path):
-        self.path = os.fspath(path)
-
-    def create(self, entries=()):
-        """Start the file afresh with ``entries`` [(time, file name relative to it)]."""
-        lines = "".join(_line(t, f) for t, f in entries)
-        tmp = f"{self.path}.tmp{os.getpid()}"
-        with open(tmp, "w", encoding="utf-8") as f:
-            f.write(HEAD + lines + TAIL)
-        os.replace(tmp, self.path)
-
-    def append(self, time, file):
-        """Add the frame ``file`` (relative to the index) at ``time``: the closing tags are
-        overwritten by the new line and written again after it."""
-        with open(self.path, "r+b") as f:
-            f.seek(-len(TAIL), os.SEEK_END)
-            f.write((_line(time, file) + TAIL).encode("utf-8"))
-
-    def read(self):
-        """[(time, file)] of an existing index, [] if there is none."""
-        if not os.path.exists(self.path):
-            return []
-        root = ET.parse(self.path).getroot()
-        return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
-
-
-class VtkSeries:
-    """A time series ``<stem>.pvd`` of frames ``<stem>_NNNN.vtu`` (one rank) or
-    ``<stem>_NNNN.pvtu`` with a piece ``<stem>_NNNN_R.vtu`` per rank. Collective methods.
-
-    Args:
-        folder: the output folder.
-        stem: the series' name ("deformed", "surface").
-        comm: the ranks writing pieces; rank 0 writes the index and the summaries.
-    """
-
-    def __init__(self, folder, stem, comm):
-        self.folder, self.stem, self.comm = os.fspath(folder), stem, comm
-        self.index = PvdIndex(os.path.join(self.folder, f"{stem}.pvd"))
-        self.started, self.template = False, None
-
-    def _start(self, keep):
-        """Keep the frames of an existing index for which ``keep(time)``, delete the files of
-        the others and rewrite the index (rank 0); the ranks then wait for each other, so that
-        no new piece is written before an old one of the same name is removed."""
-        if self.comm.rank == 0:
-            kept = []
-            for t, f in self.index.read():
-                if keep(t):
-                    kept.append((t, f))
-                else:
-                    _remove_frame(os.path.join(self.folder, f))
-            self.index.create(kept)
-        self.comm.barrier()
-        self.started = True
-
-    def resume(self, t_max):
-        """Keep the frames up to ``t_max`` (relative tolerance 1e-12) of an earlier run."""
-        self._start(lambda t: t <= t_max * (1 + 1e-12) + 1e-300)
-
-    def write(self, step, time, grid):
-        """Frame number ``step`` at ``time``: this rank's piece ``grid``; on a first frame the
-        files of an earlier run's index are removed."""
-        if not self.started:
-            self._start(lambda t: False)
-        name = f"{self.stem}_{step:04d}"
-        if self.comm.size == 1:
-            file = f"{name}.vtu"
-            write_grid(os.path.join(self.folder, file), grid)
-        else:
-            file = f"{name}.pvtu"
-            write_grid(os.path.join(self.folder, f"{name}_{self.comm.rank}.vtu"), grid)
-            if self.comm.rank == 0:
-                if self.template is None:
-                    self.template = summary_template(grid, self.comm.size, self.folder)
-                write_summary(os.path.join(self.folder, file), self.template)
-        if self.comm.rank == 0:
-            self.index.append(time, file)
-
-
-def _remove_frame(path):
-    """Delete a frame file (a ``.pvtu`` with its pieces); missing files are fine."""
-    files = [path]
-    if path.endswith(".pvtu") and os.path.exists(path):
-        try:
-            files += piece_names(path)
-        except ET.ParseError:
-            pass
-    for f in files:
-        if os.path.exists(f):
-            os.remove(f)
-
-
-def _line(time, file):
-    return f'<DataSet timestep="{float(time)!r}" group="" part="0" file={quoteattr(file)}/>\n'
-
-
 __all__ = [
     "GridBuffer",
     "OutputUnavailable",
-    "PvdIndex",
-    "VtkSeries",
     "import_vtk",
     "lagrange_line_grid",
-    "piece_names",
     "summary_template",
     "unstructured_grid",
     "write_grid",
