@@ -90,7 +90,7 @@ def run_scene(
             from .sweep import run_sweep
 
             return run_sweep(scene, out_dir, run_scene, log=log, png=png, comm=comm)
-    out = _prepare(Path(out_dir or scene.output_dir), comm)
+    out = _prepare(Path(out_dir or scene.output_dir), comm, out_dir is None and scene.file)
     log(f"beamfx: {path} -> {out}/")
     scene, refinement = _refine(scene, comm, log)
     ctx = _context(scene, out, comm, log, restart, png or animate)
@@ -108,13 +108,17 @@ def run_scene(
     return _finish(run, out, scene, refinement, log, comm, png, animate)
 
 
-def _prepare(out, comm):
+def _prepare(out, comm, file=None):
     """The output folder, checked writable, without a stale results.json; the frame writers'
-    library imported (VTK before DOLFINx) or its absence reported, before any model is built."""
+    library imported (VTK before DOLFINx) or its absence reported, before any model is built.
+    ``file``: the scene that named the folder (``[output] dir``), for the error message."""
     from .io import check_writable
     from .io.output import OutputSettings, prepare_output
 
-    check_writable(out, comm)
+    try:
+        check_writable(out, comm)
+    except OSError as e:
+        raise OSError(f"{file}: output.dir: {e}" if file else str(e)) from None
     prepare_output(OutputSettings(dir=str(out)))
     if comm.rank == 0 and (out / "results.json").exists():
         os.remove(out / "results.json")
@@ -155,7 +159,7 @@ def _context(scene, out, comm, log, restart, pictures):
     """The model and the run context of the scene's analysis."""
     from .analyses.context import RunContext
     from .analyses.trimming import Trim, trimming_summary
-    from .io.output import FrameWriter, OutputSettings
+    from .io.output import FrameWriter
 
     model = _build(scene, comm, log, scene.condense)
     trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
@@ -167,10 +171,10 @@ def _context(scene, out, comm, log, restart, pictures):
             f"the only unknowns, 3 per node instead of {per_node}, {model.unknowns()} instead of "
             f"{model.unknowns() // 3 * per_node}; shear and stretch kept"
         )
-    every = getattr(scene.settings, "frames_every", 1)
-    frames = FrameWriter(
-        out, model, OutputSettings(dir=str(out), every=every), scene.model.beams, comm
-    )
+    output = scene.output
+    if output.every is None and output.times is None:  # the analysis's default interval
+        output = replace(output, every=getattr(scene.settings, "frames_every", 1))
+    frames = FrameWriter(out, model, replace(output, dir=str(out)), scene.model.beams, comm)
     if pictures:
         from .io.pictures import write_undeformed
 

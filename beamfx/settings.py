@@ -120,7 +120,8 @@ def describe(spec):
         return "a table: " + ", ".join(f"`{s.name}`" for s in specs(spec.kind))
     word = _TYPE_WORDS[spec.kind]
     if spec.choices is not None:
-        return "one of " + ", ".join(repr(c) for c in spec.choices)
+        listed = ", ".join(repr(c) for c in spec.choices)
+        return f"a list of {listed}" if spec.kind == tuple[str, ...] else f"one of {listed}"
     parts = [word]
     if spec.positive:
         parts.append("> 0")

@@ -31,6 +31,28 @@ def test_docs_name_every_analysis_key_and_no_other():
     assert _section_keys("analysis") == fields
 
 
+def test_docs_name_every_output_key_and_no_other():
+    from beamfx.io.output import OutputSettings
+
+    assert _section_keys("output") == {s.name for s in specs(OutputSettings)}
+
+
+@pytest.mark.parametrize(
+    "output, where, words",
+    [
+        ({"every": 0}, "output.every", "> 0"),
+        ({"fields": ["u", "Q"]}, "output.fields", "'Q' is not allowed"),
+        ({"formats": ["vtk"]}, "output.formats", "'vtu'"),
+        ({"every": 2, "times": [1.0]}, "output.times", "not both"),
+        ({"colour": "red"}, "output.colour", "unknown key"),
+    ],
+)
+def test_bad_output_keys_are_named(output, where, words):
+    with pytest.raises(SceneError) as e:
+        parse_scene({**_scene({"type": "static"}), "output": output}, "s.toml")
+    assert "s.toml" in str(e.value) and where in str(e.value) and words in str(e.value)
+
+
 def test_docs_list_the_registered_types():
     text = DOCS.read_text()
     row = next(x for x in text.splitlines() if x.startswith("| `type` |") and "linear_static" in x)

@@ -56,6 +56,11 @@ class RunContext:
         if self.frames.want(step, time, last):
             self.frames.write(step, time)
 
+    def last_frame(self, step, time):
+        """The last step of a run always gets a frame (if ``every`` skipped it)."""
+        if self.frames.want(step, time, last=True) and not self.frames.has(step):
+            self.frames.write(step, time)
+
     def fallback(self):
         """The full model instead of the condensed one: the failed attempt's probes and frames
         are forgotten, and the new model is returned (and kept as :attr:`model`)."""

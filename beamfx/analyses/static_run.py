@@ -38,6 +38,8 @@ def solve(model, settings, ctx):
 
     opts = ctx.solver_options
     solved = solve_static(model, steps=settings.steps, options=opts, on_step=on_step, log=ctx.log)
+    if solved.steps:
+        ctx.last_frame(solved.steps[-1].step, solved.steps[-1].load_factor)
     return solved, tuple(path)
 
 

@@ -264,9 +264,7 @@ def run(model, settings, ctx):
         bar.close()
         history.close()
     if result.steps:
-        last = result.steps[-1]
-        if ctx.frames.want(last.step, last.time, last=True) and not ctx.frames.has(last.step):
-            ctx.frames.write(last.step, last.time)
+        ctx.last_frame(result.steps[-1].step, result.steps[-1].time)
     return Result(
         analysis=ctx.analysis,
         newton_iterations=int(sum(s.iterations for s in result.steps)),

@@ -44,7 +44,7 @@ class Scene:
     model: Model
     analysis: str = "static"
     probes: dict = field(default_factory=dict)  # name -> point ("beam:end")
-    output_dir: str = "results"
+    output: object = None  # beamfx.io.output.OutputSettings of [output]
     solver_options: dict = field(default_factory=dict)
     settings: object = None  # the analysis's Settings (beamfx/analyses/<name>_run.py)
     trimming: object = None  # analyses.trimming.Trim: the model the builder chose, and why
@@ -52,10 +52,19 @@ class Scene:
     accuracy: dict | None = None  # [accuracy]: tolerance on a probe quantity (adaptive.py)
 
     def __post_init__(self):
+        if self.output is None:
+            from ..io.output import OutputSettings
+
+            object.__setattr__(self, "output", OutputSettings())
         if self.settings is None:  # a scene made in code: the analysis's defaults
             from ..analyses.registry import analysis
 
             object.__setattr__(self, "settings", analysis(self.analysis).settings())
+
+    @property
+    def output_dir(self):
+        """The output folder of ``[output] dir``."""
+        return self.output.dir
 
     @property
     def steps(self):
@@ -322,9 +331,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
 
     probes = _probes(top)
-    ot = top.table("output", {})
-    out_dir = ot.get("dir", str, "results")
-    ot.done()
+    output = _output(top.table("output", {}))
     solver = top.get("solver", dict, {})
     accuracy_table = top.table("accuracy", None)
     top.done()
@@ -354,7 +361,7 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         model,
         analysis.name,
         probes,
-        out_dir,
+        output,
         dict(solver),
         settings,
         trimming,
@@ -489,6 +496,15 @@ def _probes(top):
         probes[name] = t.get("at", str)
         t.done()
     return probes
+
+
+def _output(t):
+    """``[output]``: where the results go and which frames, by the fields of
+    :class:`~beamfx.io.output.OutputSettings`."""
+    from ..io.output import OutputSettings
+    from .schema import read_settings
+
+    return read_settings(OutputSettings, t)
 
 
 def _analysis(t, model):
