@@ -56,6 +56,19 @@ class RunContext:
         if self.frames.want(step, time, last):
             self.frames.write(step, time)
 
+    def require_mass(self, model, analysis):
+        """Raise (naming the scene) if the model has no mass: no density and no point mass."""
+        import numpy as np
+        from mpi4py import MPI
+
+        inertia = model.discretisation.inertia.x.array
+        mass = model.comm.allreduce(float(np.max(inertia, initial=0.0)), op=MPI.MAX)
+        if mass <= 0 and not any(pm.mass or np.any(pm.inertia) for pm in self.spec.point_masses):
+            raise ValueError(
+                f"{self.file}: a {analysis} analysis needs mass: give [material] rho, or rho_A "
+                "and rho_I of the general sections, or [[masses]]"
+            )
+
     def last_frame(self, step, time):
         """The last step of a run always gets a frame (if ``every`` skipped it)."""
         if self.frames.want(step, time, last=True) and not self.frames.has(step):

@@ -39,24 +39,12 @@ class Result(_Base):
         return {"frequencies_hz": list(self.frequencies_hz)}
 
 
-def _check_mass(model, ctx):
-    from mpi4py import MPI
-
-    inertia = model.discretisation.inertia.x.array
-    mass = model.comm.allreduce(float(np.max(inertia, initial=0.0)), op=MPI.MAX)
-    if mass <= 0 and not ctx.spec.point_masses:
-        raise ValueError(
-            f"{ctx.file}: a modal analysis needs mass: give [material] rho, or rho_A and "
-            "rho_I of the general sections, or [[masses]]"
-        )
-
-
 def run(model, settings, ctx):
     """Pre-stress (if loaded and asked), then the modes nearest ``target_hz``."""
     from .modal import effective_masses, solve_modes
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes
 
-    _check_mass(model, ctx)
+    ctx.require_mass(model, "modal")
     spec, steps = ctx.spec, ()
     if settings.prestress and (spec.point_loads or spec.distributed_loads or any(spec.gravity)):
         steps = prestress(

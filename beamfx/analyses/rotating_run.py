@@ -71,18 +71,6 @@ class Result(_Base):
         return {"frequencies_hz": list(self.frequencies_hz), "stopped_by": self.stopped_by}
 
 
-def _check_mass(model, ctx):
-    from mpi4py import MPI
-
-    inertia = model.discretisation.inertia.x.array
-    mass = model.comm.allreduce(float(np.max(inertia, initial=0.0)), op=MPI.MAX)
-    if mass <= 0 and not any(pm.mass for pm in ctx.spec.point_masses):
-        raise ValueError(
-            f"{ctx.file}: a rotating analysis needs mass: give [material] rho, or rho_A and "
-            "rho_I of the general sections"
-        )
-
-
 def _branches(result):
     return tuple(
         {
@@ -102,7 +90,7 @@ def run(model, settings, ctx):
     from .campbell import campbell, write_campbell
     from .rotating import RotatingFrame
 
-    _check_mass(model, ctx)
+    ctx.require_mass(model, "rotating")
     hub = resolve_point(ctx.spec, settings.hub)[2]
     frame = RotatingFrame(model, settings.axis, hub, settings.rotary_inertia)
     ctx.log(
