@@ -1,7 +1,9 @@
 """Values at named points (mesh vertices): position, rotation, section frame, force, moment.
 
 Each rank evaluates the named points whose vertex it owns, on one adjacent local cell, with
-the shared section expression at both cell ends (ξ = 0 and 1); the answers are allgathered so
+the section expression of the frames (:func:`~beamfx.io.fields.local_fields`: the cell's
+nodes ξ = 0, 1/k, ..., 1, so one form is compiled for both; the end's values are bitwise those
+of an expression at the ends alone, checked for k = 1 to 4); the answers are allgathered so
 that every rank returns the same dictionary. The lookup of the points (which cell, which end,
 on which rank) is made once per model and list of names and cached on the model: a transient
 asks for the same probes at every step.
@@ -14,7 +16,6 @@ import numpy as np
 from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_rotation_vector
 from ._sections import evaluate
 
-CELL_ENDS = np.array([[0.0], [1.0]])
 _plans = weakref.WeakKeyDictionary()  # model -> {names: (found, cells)}
 
 
@@ -105,10 +106,12 @@ def evaluate_points(model, names=None, recover=True):
         raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
     model.sync()  # derived fields (the condensed model integrates its displacement)
     found, cells = _plan(model, names)
-    values = evaluate(model, CELL_ENDS, cells, recover)
+    nodes = np.linspace(0.0, 1.0, model.degree + 1)[:, None]  # the frames' points: one form
+    values = evaluate(model, nodes, cells, recover)
     local = {}
     for i, (n, end) in enumerate(found):
-        local[n] = _point_values(model.kin.finite, {k: a[i, end] for k, a in values.items()})
+        node = end * model.degree  # ξ = 0 or 1
+        local[n] = _point_values(model.kin.finite, {k: a[i, node] for k, a in values.items()})
 
     result = {}
     for part in comm.allgather(local) if comm.size > 1 else [local]:
