@@ -38,7 +38,7 @@ SCRIPT = "open_in_paraview.py"
 class OutputSettings:
     """What ``[output]`` says (see docs/scenes.md)."""
 
-    dir: str = option("results", doc="output folder (``beamfx run --out`` overrides it)")
+    dir: str = option("results", doc="output folder (`beamfx run --out` overrides it)")
     every: int | None = option(
         None,
         positive=True,
@@ -48,7 +48,7 @@ class OutputSettings:
     times: tuple[float, ...] | None = option(
         None,
         doc="frames at the first accepted step at or past each of these times (load "
-        "factors), instead of ``every``",
+        "factors), instead of `every`",
     )
     fields: tuple[str, ...] = option(
         POINT_ARRAYS, choices=POINT_ARRAYS, doc="point arrays written in the frames"
@@ -56,7 +56,7 @@ class OutputSettings:
     formats: tuple[str, ...] = option(
         VTK_FORMATS,
         choices=FORMATS,
-        doc="files written: ``vtu`` (centre line), ``surface`` (swept section), ``xdmf`` "
+        doc="files written: `vtu` (centre line), `surface` (swept section), `xdmf` "
         "(HDF5; its cost grows with the frames)",
     )
 
