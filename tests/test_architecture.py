@@ -24,7 +24,6 @@ KNOWN = {
         "beamfx/analyses/continuation.py::trace_path",
         "beamfx/analyses/transient.py::solve_transient",
         "beamfx/bench/adaptive_bend45.py::AdaptiveCase.run_setting",
-        "beamfx/bench/run.py::markdown",
         "beamfx/bench/solid_scaling.py::report",
         "beamfx/solvers/arclength.py::ArcLengthSolver.trace",
     ],

@@ -166,6 +166,88 @@ def _s(row, key):
     return f"{row[key]:.3f}" if key in row else "-"
 
 
+def _case_lines(r, figures):
+    """The report section of one case: reference, table of settings, profile, orders."""
+    from .profiling import case_lines
+
+    lines = []
+    lines += [
+        "",
+        f"## {r['id']}: {r['title']}",
+        "",
+        f"*{r['paper']}.* {r['note']}",
+        "",
+        *(
+            [f"![{r['id']}: convergence and cost]({figures[r['id']]})", ""]
+            if r["id"] in figures
+            else []
+        ),
+        "Reference: "
+        + ", ".join(f"{k} = {v:.10g}" for k, v in r["reference"].items())
+        + (" (finest setting)" if r["reference_is_finest_setting"] else ""),
+        "",
+        f"Tolerance {r['tolerance']:g} ({'relative' if r['error_scale'] == 'relative' else 'absolute / ' + str(r['error_scale'])}).",
+        "",
+        "| elements x degree | unknowns | Newton its | cold s | whole run s | solve only s "
+        "| error | " + " | ".join(r["reference"]) + " |",
+        "|---|---|---|---|---|---|---|" + "---|" * len(r["reference"]),
+    ]
+    for row in r["rows"]:
+        dt = f", dt = {row['dt']:g}" if "dt" in row else ""
+        lines.append(
+            f"| {row['elements']} x P{row['degree']}{dt} | {row['unknowns']} | {row['newton_iterations']} | "
+            f"{row['wall_s_cold']:.2f} | {_s(row, 'wall_s_whole')} | {row['wall_s_warm']:.3f} | "
+            f"{row['error']:.2e} | "
+            + " | ".join(f"{row['values'][k]:.8g}" for k in r["reference"])
+            + " |"
+        )
+    lines += case_lines(r)  # adaptive and planar-vs-full tables
+    c = r["cheapest_within_tolerance"]
+    if c and "warm_per_iteration_s" in c:
+        t = c["warm_per_iteration_s"]
+        split = (
+            f"Per Newton iteration at {c['elements']} x P{c['degree']} (warm, ms): "
+            f"assemble residual {1e3 * t['assemble_F']:.2f}, tangent "
+            f"{1e3 * t['assemble_J']:.2f}, LU factorisation {1e3 * t['factorise']:.2f}, "
+            f"triangular solves {1e3 * t['triangular_solve']:.2f}, Python and the rest "
+            f"{1e3 * t['python']:.2f}."
+        )
+        lines += ["", split]
+    if r["rates"]:
+        lines += [
+            "",
+            "Observed order: "
+            + ", ".join(
+                (
+                    f"in time at dt = {x['dt']:g}: {x['rate']:.2f}"
+                    if "dt" in x
+                    else f"P{x['degree']} at {x['elements']} el: {x['rate']:.2f}"
+                )
+                for x in r["rates"]
+            ),
+        ]
+    if "criterion_1mm" in r:
+        lines += [
+            "",
+            "1 mm criterion (fewest unknowns): "
+            + ", ".join(
+                f"P{p}: {v['elements']} elements, {v['unknowns']} unknowns"
+                for p, v in r["criterion_1mm"].items()
+            )
+            + "; published: "
+            + ", ".join(
+                f"{k}: " + (f"{v['dofs']} dofs" if "dofs" in v else f"{v['states']} states")
+                for k, v in r["extra"]["problem_size"].items()
+            ),
+        ]
+    if "inside_published_spread" in r:
+        lines += [
+            "",
+            f"Converged tip inside the published spread: {r['inside_published_spread']}",
+        ]
+    return lines
+
+
 def markdown(results, figures=None, note=None):
     """The report; ``figures`` maps case ids (and "summary") to PNG files beside it, ``note``
     says why there are none."""
@@ -222,84 +304,11 @@ def markdown(results, figures=None, note=None):
                 else "- | - | - | - | - | - |"
             )
         )
-    from .profiling import case_lines, profile_lines
+    from .profiling import profile_lines
 
     lines += profile_lines(results)
     for r in results:
-        lines += [
-            "",
-            f"## {r['id']}: {r['title']}",
-            "",
-            f"*{r['paper']}.* {r['note']}",
-            "",
-            *(
-                [f"![{r['id']}: convergence and cost]({figures[r['id']]})", ""]
-                if r["id"] in figures
-                else []
-            ),
-            "Reference: "
-            + ", ".join(f"{k} = {v:.10g}" for k, v in r["reference"].items())
-            + (" (finest setting)" if r["reference_is_finest_setting"] else ""),
-            "",
-            f"Tolerance {r['tolerance']:g} ({'relative' if r['error_scale'] == 'relative' else 'absolute / ' + str(r['error_scale'])}).",
-            "",
-            "| elements x degree | unknowns | Newton its | cold s | whole run s | solve only s "
-            "| error | " + " | ".join(r["reference"]) + " |",
-            "|---|---|---|---|---|---|---|" + "---|" * len(r["reference"]),
-        ]
-        for row in r["rows"]:
-            dt = f", dt = {row['dt']:g}" if "dt" in row else ""
-            lines.append(
-                f"| {row['elements']} x P{row['degree']}{dt} | {row['unknowns']} | {row['newton_iterations']} | "
-                f"{row['wall_s_cold']:.2f} | {_s(row, 'wall_s_whole')} | {row['wall_s_warm']:.3f} | "
-                f"{row['error']:.2e} | "
-                + " | ".join(f"{row['values'][k]:.8g}" for k in r["reference"])
-                + " |"
-            )
-        lines += case_lines(r)  # adaptive and planar-vs-full tables
-        c = r["cheapest_within_tolerance"]
-        if c and "warm_per_iteration_s" in c:
-            t = c["warm_per_iteration_s"]
-            split = (
-                f"Per Newton iteration at {c['elements']} x P{c['degree']} (warm, ms): "
-                f"assemble residual {1e3 * t['assemble_F']:.2f}, tangent "
-                f"{1e3 * t['assemble_J']:.2f}, LU factorisation {1e3 * t['factorise']:.2f}, "
-                f"triangular solves {1e3 * t['triangular_solve']:.2f}, Python and the rest "
-                f"{1e3 * t['python']:.2f}."
-            )
-            lines += ["", split]
-        if r["rates"]:
-            lines += [
-                "",
-                "Observed order: "
-                + ", ".join(
-                    (
-                        f"in time at dt = {x['dt']:g}: {x['rate']:.2f}"
-                        if "dt" in x
-                        else f"P{x['degree']} at {x['elements']} el: {x['rate']:.2f}"
-                    )
-                    for x in r["rates"]
-                ),
-            ]
-        if "criterion_1mm" in r:
-            lines += [
-                "",
-                "1 mm criterion (fewest unknowns): "
-                + ", ".join(
-                    f"P{p}: {v['elements']} elements, {v['unknowns']} unknowns"
-                    for p, v in r["criterion_1mm"].items()
-                )
-                + "; published: "
-                + ", ".join(
-                    f"{k}: " + (f"{v['dofs']} dofs" if "dofs" in v else f"{v['states']} states")
-                    for k, v in r["extra"]["problem_size"].items()
-                ),
-            ]
-        if "inside_published_spread" in r:
-            lines += [
-                "",
-                f"Converged tip inside the published spread: {r['inside_published_spread']}",
-            ]
+        lines += _case_lines(r, figures)
     return "\n".join(lines) + "\n"
 
 
