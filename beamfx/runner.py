@@ -3,6 +3,7 @@
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import cached_property, partial
 from importlib import resources
@@ -11,7 +12,7 @@ from pathlib import Path
 DEFAULT_SCENE = "bend45.toml"
 
 
-def default_scene_path():
+def default_scene_path() -> Path:
     """The built-in default scene (the 45-degree bend)."""
     return Path(str(resources.files("beamfx") / "scenes" / DEFAULT_SCENE))
 
@@ -59,15 +60,15 @@ class RunResult:
 
 
 def run_scene(
-    path=None,
-    out_dir=None,
-    log=None,
-    restart=False,
-    png=False,
-    animate=False,
+    path: str | os.PathLike | None = None,
+    out_dir: str | os.PathLike | None = None,
+    log: Callable[[str], None] | None = None,
+    restart: bool = False,
+    png: bool = False,
+    animate: bool = False,
     comm=None,
     scene=None,
-):
+) -> "RunResult | dict":
     """Solve the scene at ``path`` (built-in default if None) on ``comm`` (default: all
     ranks) and return its :class:`RunResult`; a ``[[sweep]]`` file returns the sweep's table
     (:func:`beamfx.sweep.run_sweep`). ``scene``: already parsed (``path`` then only names it).
@@ -247,7 +248,7 @@ def _finish(run, out, scene, refinement, log, comm, png, animate):
     return run
 
 
-def check_scene(path):
+def check_scene(path: str | os.PathLike):
     """Validate a scene without solving: keys, types, points, supports; for a sweep file every
     member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
     from .analyses.checks import check_supported

@@ -37,7 +37,7 @@ class Analysis(NamedTuple):
 
 
 @cache
-def analyses():
+def analyses() -> dict[str, Analysis]:
     """``{name: Analysis}`` of every ``*_run`` module of this package, in name order."""
     from . import __path__ as here
 
@@ -53,7 +53,7 @@ def analyses():
     return dict(sorted(found.items()))
 
 
-def analysis(name):
+def analysis(name: str) -> Analysis:
     """The :class:`Analysis` called ``name``.
 
     Raises:

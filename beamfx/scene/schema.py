@@ -64,7 +64,7 @@ def _check_range(spec, value, fail):
             fail(f"must be {describe(spec)}, got {v!r}")
 
 
-def read_settings(cls, table, defaults=None, done=True):
+def read_settings(cls: type, table, defaults: dict | None = None, done: bool = True):
     """An instance of the settings class ``cls`` from ``table`` (:class:`~.table.Table`).
 
     Args:
