@@ -274,7 +274,9 @@ def markdown(results, figures=None, note=None):
             "[peers.md](peers.md) (`make bench-peers`); the 3D solid against the beam, "
             "[../solid.md](../solid.md), and at 231k unknowns on 1 and 2 ranks beside the beam, "
             "[solid_scaling.md](solid_scaling.md) (`make bench-solid-scaling`); the Pai beam "
-            "sweeps, [../pai_beam.md](../pai_beam.md)."
+            "sweeps, [../pai_beam.md](../pai_beam.md); what the ParaView frames cost, per frame "
+            "up to 10^4 frames and in whole runs, [output_cost.md](output_cost.md) "
+            "(`python -m beamfx.bench.output_cost`)."
         ),
         "",
     ]
