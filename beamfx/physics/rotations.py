@@ -152,5 +152,6 @@ def unwrap_rotation_vector(q, previous):
     axis, angle = axis_angle(q)
     prev = np.asarray(previous, dtype=float)
     k0 = int(np.ceil(np.linalg.norm(prev) / (2 * np.pi)))
-    candidates = [(angle + 2 * np.pi * k) * axis for k in range(-k0 - 2, k0 + 3)]
-    return min(candidates, key=lambda c: np.linalg.norm(c - prev))
+    turns = np.arange(-k0 - 2, k0 + 3)
+    candidates = (angle + 2 * np.pi * turns)[:, None] * np.asarray(axis, float)[None, :]
+    return candidates[np.argmin(np.linalg.norm(candidates - prev, axis=1))]
