@@ -4,7 +4,7 @@
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import cached_property, partial
 from importlib import resources
 from pathlib import Path
@@ -30,7 +30,6 @@ class RunResult:
     paraview: dict  # the files written for ParaView
     accuracy: dict | None = None  # the [accuracy] refinement, if asked
     pictures: dict | None = None  # the pictures rendered, if asked
-    extra: dict = field(default_factory=dict)
 
     @property
     def converged(self):
@@ -91,7 +90,7 @@ def run_scene(
             from .sweep import run_sweep
 
             return run_sweep(scene, out_dir, run_scene, log=log, png=png, comm=comm)
-    out = _prepare(Path(out_dir or scene.output_dir), comm, out_dir is None and scene.file)
+    out = _prepare(Path(out_dir or scene.output_dir), scene, comm, out_dir is None)
     log(f"beamfx: {path} -> {out}/")
     scene, refinement = _refine(scene, comm, log)
     ctx = _context(scene, out, comm, log, restart, png or animate)
@@ -109,18 +108,18 @@ def run_scene(
     return _finish(run, out, scene, refinement, log, comm, png, animate)
 
 
-def _prepare(out, comm, file=None):
+def _prepare(out, scene, comm, named_by_scene):
     """The output folder, checked writable, without a stale results.json; the frame writers'
     library imported (VTK before DOLFINx) or its absence reported, before any model is built.
-    ``file``: the scene that named the folder (``[output] dir``), for the error message."""
+    ``named_by_scene``: the folder is the scene's ``[output] dir`` (named in the error)."""
     from .io import check_writable
-    from .io.output import OutputSettings, prepare_output
+    from .io.output import prepare_output
 
     try:
         check_writable(out, comm)
     except OSError as e:
-        raise OSError(f"{file}: output.dir: {e}" if file else str(e)) from None
-    prepare_output(OutputSettings(dir=str(out)))
+        raise OSError(f"{scene.file}: output.dir: {e}" if named_by_scene else str(e)) from None
+    prepare_output(scene.output)
     if comm.rank == 0 and (out / "results.json").exists():
         os.remove(out / "results.json")
     return out
@@ -159,12 +158,10 @@ def _build(scene, comm, log, condense):
 def _context(scene, out, comm, log, restart, pictures):
     """The model and the run context of the scene's analysis."""
     from .analyses.context import RunContext
-    from .analyses.trimming import Trim, trimming_summary
     from .io.output import FrameWriter
 
     model = _build(scene, comm, log, scene.condense)
-    trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
-    log(f"model: {trimming_summary(trim, model.kin, model.unknowns())[0]}")
+    log(f"model: {_trimming(scene, model)[0]}")
     if scene.condense:
         per_node = 3 + model.kin.rotation_size
         log(
@@ -197,12 +194,17 @@ def _context(scene, out, comm, log, restart, pictures):
     )
 
 
-def _model_entry(scene, ctx):
-    """The ``model`` entry of results.json: what was solved."""
+def _trimming(scene, model):
+    """(log line, results entry) of the model the scene builder chose for ``model``."""
     from .analyses.trimming import Trim, trimming_summary
 
+    trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
+    return trimming_summary(trim, model.kin, model.unknowns())
+
+
+def _model_entry(scene, ctx):
+    """The ``model`` entry of results.json: what was solved."""
     model, kin = ctx.model, ctx.model.kin
-    trim = scene.trimming or Trim(kin.plane, False, "given as a model")
     return {
         "beams": [b.name for b in scene.model.beams],
         "degree": model.degree,
@@ -211,7 +213,7 @@ def _model_entry(scene, ctx):
         "plane": kin.plane,
         "shear": kin.shear,
         "stretch": kin.stretch,
-        "trimming": trimming_summary(trim, kin, model.unknowns())[1],
+        "trimming": _trimming(scene, model)[1],
         "condensed": bool(scene.condense and ctx.rebuild is not None),
     }
 

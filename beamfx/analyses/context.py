@@ -50,10 +50,10 @@ class RunContext:
         self.latest = track_rotations(self.latest if track else None, values)
         return self.latest
 
-    def step(self, model, step, time, last=False):
+    def step(self, model, step, time):
         """After an accepted step: probes tracked, and a frame where the output asks."""
         self.probe_values(model)
-        if self.frames.want(step, time, last):
+        if self.frames.want(step, time):
             self.frames.write(step, time)
 
     def require_mass(self, model, analysis):
@@ -71,7 +71,7 @@ class RunContext:
 
     def last_frame(self, step, time):
         """The last step of a run always gets a frame (if ``every`` skipped it)."""
-        if self.frames.want(step, time, last=True) and not self.frames.has(step):
+        if self.frames.want(step, time, last=True):
             self.frames.write(step, time)
 
     def fallback(self):
@@ -80,7 +80,7 @@ class RunContext:
         self.latest = None
         self.frames.resume(0.0)
         self.model, self.rebuild = self.rebuild(), None
-        self.frames.model = self.model
+        self.frames.follow(self.model)
         return self.model
 
 

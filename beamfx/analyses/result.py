@@ -68,7 +68,7 @@ class Result:
         out["newton_iterations"] = int(self.newton_iterations)
         base = {f.name for f in dataclasses.fields(Result)}
         for f in dataclasses.fields(self):
-            if f.name not in base and f.metadata.get("json", True):
+            if f.name not in base:
                 out[f.name] = plain(getattr(self, f.name))
         return out
 

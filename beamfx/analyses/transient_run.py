@@ -60,7 +60,9 @@ class Settings:
     @property
     def frames_every(self):
         """Frames every this many steps, unless ``[output]`` says otherwise."""
-        return self.output_every or max(1, round(self.t_end / self.dt / 200))
+        from ..io.output import default_every
+
+        return self.output_every or default_every("transient", self.t_end / self.dt)
 
     def solver(self):
         """The integrator's :class:`~beamfx.analyses.transient.TransientSettings`."""

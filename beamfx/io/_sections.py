@@ -50,6 +50,15 @@ def section_expression(model):
 
 
 @lru_cache
+def cell_nodes(degree):
+    """The k + 1 equispaced nodes ξ = 0, 1/k, ..., 1 of a cell, shape (k + 1, 1): the points
+    of the frames and of the probes (one compiled expression serves both)."""
+    nodes = np.linspace(0.0, 1.0, degree + 1)[:, None]
+    nodes.flags.writeable = False
+    return nodes
+
+
+@lru_cache
 def gauss_points(degree):
     """The ``degree`` Gauss–Legendre points on [0, 1]: the shear/axial rule of the model
     (cached; read only)."""

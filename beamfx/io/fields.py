@@ -7,7 +7,7 @@ and keeps the section force and moment of each cell (they jump at point loads an
 
 import numpy as np
 
-from ._sections import evaluate
+from ._sections import cell_nodes, evaluate
 
 POINT_ARRAYS = ("X", "u", "e1", "e2", "e3", "N", "M")
 
@@ -35,7 +35,7 @@ def local_fields(model, recover=True):
     original = np.asarray(m.topology.original_cell_index[:n_owned], dtype=np.int64)
     order = np.argsort(original, kind="stable")
     cells = np.arange(n_owned, dtype=np.int32)[order]
-    values = evaluate(model, np.linspace(0.0, 1.0, k + 1)[:, None], cells, recover)
+    values = evaluate(model, cell_nodes(k), cells, recover)
     axes = values["axes"]
     out = {"X": values["X"], "u": values["u"], "N": values["N"], "M": values["M"]}
     out.update(e1=axes[..., 0], e2=axes[..., 1], e3=axes[..., 2])

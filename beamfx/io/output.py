@@ -167,9 +167,10 @@ class FrameWriter:
         """Is accepted step ``step`` at ``time`` a frame? (:class:`FramePolicy`)"""
         return self.policy.want(step, time, last)
 
-    def has(self, step):
-        """Was step ``step`` the last frame written?"""
-        return step == self.policy.last_step
+    def follow(self, model):
+        """Write the state of ``model`` from now on: another formulation on the same mesh
+        (the full model a condensed one fell back to); the series go on."""
+        self.model = model
 
     def write(self, step, time):
         """Write the current state as frame ``step`` at ``time`` (each rank its own piece)."""

@@ -14,7 +14,7 @@ import weakref
 import numpy as np
 
 from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_rotation_vector
-from ._sections import evaluate
+from ._sections import cell_nodes, evaluate
 
 _plans = weakref.WeakKeyDictionary()  # model -> {names: (found, cells)}
 
@@ -106,8 +106,7 @@ def evaluate_points(model, names=None, recover=True):
         raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
     model.sync()  # derived fields (the condensed model integrates its displacement)
     found, cells = _plan(model, names)
-    nodes = np.linspace(0.0, 1.0, model.degree + 1)[:, None]  # the frames' points: one form
-    values = evaluate(model, nodes, cells, recover)
+    values = evaluate(model, cell_nodes(model.degree), cells, recover)
     local = {}
     for i, (n, end) in enumerate(found):
         node = end * model.degree  # ξ = 0 or 1
