@@ -61,7 +61,12 @@ def _run(args):
     results = run_scene(
         args.scene, args.out, restart=args.restart, png=args.png, animate=args.animate
     )
-    failed = [m["member"] for m in results.get("members", []) if m["status"] != "converged"]
+    if "members" not in results:  # one scene: results.json says how it ended
+        if results.converged:
+            return 0
+        print(f"beamfx: {results.result.status}: {results.result.reason}", file=sys.stderr)
+        return 3
+    failed = [m["member"] for m in results["members"] if m["status"] != "converged"]
     if failed:  # a sweep: the table is written, but say that it has holes
         print(f"beamfx: sweep members {failed} failed (see sweep.md)", file=sys.stderr)
         return 3

@@ -51,6 +51,8 @@ def _solve_member(member, folder, comm, log, run_scene, **options):
             member.scene.file, folder, log=log, comm=comm, scene=member.scene, **options
         )
         row.update(status=results.result.status, **summary(results))
+        if results.result.reason is not None:  # stopped before the end (sweep.md says why)
+            row["reason"] = results.result.reason
     except SolveFailed as e:
         row.update(status="failed", reason=str(e))
     row["wall_s"] = time.perf_counter() - t0
@@ -199,5 +201,5 @@ def to_markdown(table):
     ]
     lines += ["| " + " | ".join(str(f(r)) for _, f in cols) + " |" for r in table["members"]]
     failed = [r for r in table["members"] if r["status"] != "converged"]
-    lines += [""] + [f"member {r['member']} failed: {r['reason']}" for r in failed]
+    lines += [""] + [f"member {r['member']} {r['status']}: {r['reason']}" for r in failed]
     return "\n".join(lines) + "\n"

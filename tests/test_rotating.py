@@ -317,3 +317,23 @@ def test_rotating_scene_writes_the_campbell_files(tmp_path):
     )
     assert (out / "campbell.png").stat().st_size > 1000
     assert json.loads((out / "results.json").read_text())["campbell"] == results["campbell"]
+
+
+def test_a_speed_without_steady_state_stops_the_run_with_exit_status_3(tmp_path):
+    """Past the rod's first axial frequency ((π/2) sqrt(E/ρ)/L = 8.1e3 rad/s here) Newton finds
+    no steady state: results.json keeps the speeds reached with converged false, status
+    "stopped" and the reason, and `beamfx run` exits 3, not 0."""
+    from beamfx.cli import main
+
+    comm = MPI.COMM_WORLD
+    folder = Path(comm.bcast(str(tmp_path)))
+    out, scene = folder / "out", folder / "blade.toml"
+    if comm.rank == 0:
+        text = SCENE.format(out=out).replace("[0, 100, 200, 300]", "[0, 1000, 12000]")
+        scene.write_text(text.replace("modes = 3", "modes = 1"))
+    comm.barrier()
+    assert main(["run", str(scene)]) == 3
+    results = json.loads((out / "results.json").read_text())
+    assert results["converged"] is False and results["status"] == "stopped"
+    assert results["reason"] == results["stopped_by"] and results["reason"]
+    assert results["speeds_rad_s"] == [0, 1000]
