@@ -215,3 +215,29 @@ def test_lee_frame_from_its_scene_file(tmp_path):
     rows = (tmp_path / "out" / "path.csv").read_text().splitlines()
     assert len(rows) == len(results["path"])  # header + one row per step after the start
     assert json.loads((tmp_path / "out" / "results.json").read_text())["converged"]
+
+
+def test_a_trace_cut_short_by_max_steps_is_not_converged(tmp_path):
+    """Lee's frame with max_steps = 3: the trace ends before its displacement limit, so
+    results.json says converged false (status "stopped", the reason) and `beamfx run` exits
+    3."""
+    import json
+    import re
+    from pathlib import Path
+
+    from beamfx.cli import main
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
+    text = next(b for b in re.findall(r"```toml\n(.*?)```", doc, re.DOTALL) if "Lee's frame" in b)
+    text = text.replace('dir = "results/lee_frame"', f'dir = "{tmp_path / "out"}"')
+    scene = tmp_path / "lee.toml"
+    scene.write_text(
+        text.replace(
+            'displacement_limit = ["uy", 55]', 'displacement_limit = ["uy", 55]\nmax_steps = 3'
+        )
+    )
+    assert main(["run", str(scene)]) == 3
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["converged"] is False and results["status"] == "stopped"
+    assert results["stopped_by"] == "max_steps" and "max_steps" in results["reason"]
+    assert len(results["path"]) == 4  # the start and three steps

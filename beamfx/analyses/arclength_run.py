@@ -121,8 +121,12 @@ def run(model, settings, ctx):
             f"  limit point ({p['kind']}): load factor {p['load_factor']:.6g} "
             f"at {result.control_point}"
         )
+    short = result.reason == "max_steps"  # neither the target nor the limit was reached
+    why = f"max_steps: {settings.max_steps} steps did not reach the end asked for"
     return Result(
         analysis=ctx.analysis,
+        status="stopped" if short else "converged",
+        reason=why if short else None,
         load_steps=tuple(result.steps),
         newton_iterations=int(sum(s.iterations for s in result.steps)),
         seconds=dict(result.seconds),
