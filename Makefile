@@ -18,7 +18,7 @@ run: install
 	$(VENV)/bin/beamfx run
 
 # ParaView's pvpython runs on its own after the rest: on a loaded machine it sometimes aborts
-# while creating its X window (tests/test_paraview.py retries that start-up failure)
+# while creating its X window (tests/scenes/test_paraview.py retries that start-up failure)
 test: install
 	$(PY) -m pytest -n 2 -m "not slow and not mpi and not paraview" tests
 	$(PY) -m pytest -p no:cacheprovider -m "paraview and not slow" tests

@@ -2,7 +2,7 @@
 
 A formulation turns a :class:`~beamfx.spec.Model` into unknowns and forms on a shared
 :class:`~beamfx.analyses.discretisation.Discretisation`. Two protocols name what the rest of
-beamfx may use of one (``tests/test_formulation.py`` checks that the analyses use nothing else):
+beamfx may use of one (``tests/unit/test_formulation.py`` checks that the analyses use nothing else):
 
 * :class:`Formulation`, what a static solve, the probes and field writers and the runner use:
   :class:`~beamfx.analyses.model.BeamModel` (full or planar) and
@@ -96,7 +96,7 @@ class BeamFormulation(Formulation, Protocol):
         """Time of a transient: loads and supports with a history take their values at t."""
 
 
-#: members of each protocol, for the checks of what the analyses use (tests/test_formulation.py)
+#: members of each protocol, for the checks of what the analyses use (tests/unit/test_formulation.py)
 FORMULATION_MEMBERS = frozenset(
     name for name in vars(Formulation) if not name.startswith("_")
 ) | frozenset(Formulation.__annotations__)

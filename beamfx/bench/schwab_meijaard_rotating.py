@@ -216,7 +216,7 @@ register(
         "Southwell coefficient, psi'' + (rho omega_0^2/E) psi = -phi), and the stretched "
         "beam bends more easily per unit reference length; for this beam (in-plane omega_0 "
         "an eighth of the first axial frequency) the lead-lag coefficient nearly halves "
-        "(tests/test_rotating.py checks it against that perturbation formula). At high speed the extension decides: the steady stretch of a "
+        "(tests/convergence/test_rotating.py checks it against that perturbation formula). At high speed the extension decides: the steady stretch of a "
         "linear-elastic rod, x'' + (rho Omega^2/E) x = 0, grows without bound as Omega "
         "approaches the first axial frequency (pi/2) sqrt(E/rho)/L, alpha = "
         f"{OMEGA_AXIAL / OMEGA_BY:.2f}, while the lead-lag frequency falls to zero (columns "

@@ -134,7 +134,7 @@ NOTE = (
     "only, several times pi EI/L, which do not converge as the mesh is refined: the continuous "
     "one has none), and their instability is "
     "kinetic: about the twisted shaft the double bending frequency splits into a complex "
-    "pair at any torque, Im(omega) proportional to M (flutter; tests/test_torque_buckling.py). "
+    "pair at any torque, Im(omega) proportional to M (flutter; tests/convergence/test_torque_buckling.py). "
     "The semitangential torque (potential -M.psi) turns by half the rotation: "
     "exp(iML/EI) = -1, M_cr = pi EI/L. The quasitangential couple turns with the rotation "
     "about its forces' direction only: cos(ML/EI) = 0, M_cr = pi EI/(2L); the mean of the "

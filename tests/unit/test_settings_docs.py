@@ -11,7 +11,7 @@ from beamfx.analyses.registry import analyses
 from beamfx.scene import SceneError, parse_scene
 from beamfx.settings import markdown_table, specs
 
-DOCS = Path(__file__).parents[1] / "docs" / "scenes.md"
+DOCS = Path(__file__).parents[2] / "docs" / "scenes.md"
 
 
 def _section_keys(title):

@@ -1,5 +1,5 @@
 """The code's structure, read from its syntax trees: the analyses use formulations only through
-their protocol, no module calls another's private members, and the layers hold (no import cycles: tests/test_architecture.py)."""
+their protocol, no module calls another's private members, and the layers hold (no import cycles: tests/unit/test_architecture.py)."""
 
 import ast
 from dataclasses import fields
@@ -10,7 +10,7 @@ import pytest
 from beamfx.analyses.discretisation import Discretisation
 from beamfx.analyses.formulation import BEAM_FORMULATION_MEMBERS, FORMULATION_MEMBERS
 
-PACKAGE = Path(__file__).resolve().parents[1] / "beamfx"
+PACKAGE = Path(__file__).resolve().parents[2] / "beamfx"
 
 #: analyses modules that define formulations or read only model descriptions
 NOT_USERS = {"model", "condensed", "discretisation", "formulation", "spec", "checks", "trimming"}
@@ -160,7 +160,7 @@ def test_the_private_scan_flags_a_cross_call():
 
 
 # --- imports (the import graph of scripts/check_architecture.py; its cycles are checked in
-# tests/test_architecture.py) -------------------------------------------------------------------
+# tests/unit/test_architecture.py) -------------------------------------------------------------------
 
 
 def _import_graph():

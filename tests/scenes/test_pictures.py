@@ -6,8 +6,7 @@ from importlib.util import find_spec
 
 import numpy as np
 import pytest
-from test_paraview import SHAKEN
-from test_solid import SCENE as SOLID_SCENE
+from scenekit import SHAKEN, SOLID_SCENE
 
 from beamfx.io import pictures
 from beamfx.runner import run_scene

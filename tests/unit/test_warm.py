@@ -14,7 +14,7 @@ from beamfx.runner import check_scene
 from beamfx.scene import load_scene
 from beamfx.warm import DEGREES, _cache_files, grid, scene_sources, shortened
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 SHAKEN = """[material]
 E = 210e9

@@ -201,7 +201,7 @@ def test_lee_frame_from_its_scene_file(tmp_path):
 
     from beamfx.runner import run_scene
 
-    doc = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "scenes.md").read_text()
     text = next(b for b in re.findall(r"```toml\n(.*?)```", doc, re.DOTALL) if "Lee's frame" in b)
     scene = tmp_path / "lee.toml"
     scene.write_text(text.replace('dir = "results/lee_frame"', f'dir = "{tmp_path / "out"}"'))
@@ -227,7 +227,7 @@ def test_a_trace_cut_short_by_max_steps_is_not_converged(tmp_path):
 
     from beamfx.cli import main
 
-    doc = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "scenes.md").read_text()
     text = next(b for b in re.findall(r"```toml\n(.*?)```", doc, re.DOTALL) if "Lee's frame" in b)
     text = text.replace('dir = "results/lee_frame"', f'dir = "{tmp_path / "out"}"')
     scene = tmp_path / "lee.toml"

@@ -27,7 +27,7 @@ Conventions
 * Rotations are integrated as unit quaternions ``q = (w, x, y, z)`` with
   ``q' = 1/2 q * (0, K)`` (which is ``Lambda' = Lambda hat(K)``).
 
-Run ``/usr/bin/python3 tests/rod_equations.py`` to print the reference numbers; the
+Run ``/usr/bin/python3 tests/convergence/rod_equations.py`` to print the reference numbers; the
 ``test_*`` functions are collected by pytest.
 """
 

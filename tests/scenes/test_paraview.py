@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 from mpi4py import MPI
+from scenekit import SHAKEN
 
 import beamfx.io.pvscripts
 from beamfx.runner import default_scene_path, run_scene
@@ -90,29 +91,6 @@ def test_paraview_reads_and_renders_bend45(tmp_path):
     assert Path(image["path"]).stat().st_size > 5000
     assert image["colours"] > 50  # shaded and colour-mapped, not one flat colour
     assert 0.005 < image["foreground"] < 0.5  # the beam is in the picture, and not all of it
-
-
-SHAKEN = """
-[material]
-E = 210e9
-nu = 0.3
-rho = 7850
-[[beams]]
-name = "arm"
-curve = { shape = "line", start = [0, 0, 0], end = [0, 0, 0.5] }
-section = { type = "rectangle", h = 0.002, w = 0.03 }
-elements = 4
-[[supports]]
-at = "arm:start"
-fix = "all"
-displacement = [0.02, 0, 0]
-history = "(1 - cos(pi * t / 0.2)) / 2"
-[analysis]
-type = "ANALYSIS"
-[[probes]]
-name = "tip"
-at = "arm:end"
-"""
 
 
 def _pvcheck(out, tip=None, attempts=6):
@@ -203,7 +181,7 @@ def test_paraview_reads_every_format(tmp_path):
     from dataclasses import replace
 
     import numpy as np
-    from test_io import SECTION, TOL_POSITION, L, rollup_model
+    from scenekit import SECTION, TOL_POSITION, L, rollup_model
 
     from beamfx.analyses.static import solve_static
     from beamfx.io import FrameWriter, OutputSettings

@@ -8,7 +8,7 @@ beam is a half circle: tip at (0, 0, 2L/π) turned by π.
 
 MPI: probes are the same on every rank; gathered nodal fields live on rank 0, where the
 frames (each rank writes its own piece) are read back and checked (the folder is rank 0's
-tmp_path). tests/test_output_mpi.py compares the pieces of 2 ranks with 1 rank's file.
+tmp_path). tests/mpi/test_output_mpi.py compares the pieces of 2 ranks with 1 rank's file.
 """
 
 import io
@@ -20,7 +20,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from mpi4py import MPI
+from scenekit import DEGREE, EI, ELEMENTS, SECTION, TOL_MOMENT, TOL_POSITION, L, comm, rollup_model
 
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
@@ -40,26 +40,7 @@ from beamfx.io._sections import rotation_matrices
 from beamfx.io.output import FramePolicy, default_every
 from beamfx.physics.kinematics import Kinematics
 from beamfx.physics.rotations import np_quaternion, np_rotation
-from beamfx.physics.sections import Section
 from beamfx.spec import Beam, Model, PointLoad, Support
-
-comm = MPI.COMM_WORLD
-L, EI = 10.0, 215e3
-SECTION = Section(EA=1770e3, GA_y=1770e3, GA_z=1770e3, GJ=8.16e3, EI_y=EI, EI_z=EI)
-ELEMENTS, DEGREE = 8, 3
-# tip error of this mesh in the two-turn roll-up is 1.4e-5 L (notes §11), at half a turn 5e-10 L;
-# the stress resultants converge at O(h^4) and are off by 3e-6 here
-TOL_POSITION, TOL_MOMENT = 1e-5, 1e-5
-
-
-def rollup_model(turns, comm=comm):
-    M = turns * 2 * np.pi * EI / L
-    spec = Model(
-        beams=(Beam("b", Line((0, 0, 0), (L, 0, 0)), SECTION, ELEMENTS, DEGREE),),
-        supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
-        point_loads=(PointLoad("b:end", moment=(0, -M, 0)),),
-    )
-    return BeamModel(spec, comm), M
 
 
 def exact_tip(phi):

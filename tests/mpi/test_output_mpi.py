@@ -1,9 +1,9 @@
 """Run under ``mpirun -n 2``: the frames of 2 ranks are pieces that, merged and put in the
 order of the input cell index, equal the frame of 1 rank; each rank wrote its own piece.
 
-The half-circle roll-up (tests/test_io.py) with a rectangular section is solved on one rank
+The half-circle roll-up (tests/unit/test_io.py) with a rectangular section is solved on one rank
 (COMM_SELF) and on all; the two solutions agree to the solver's tolerance, so the files are
-compared with the tolerance of tests/test_mpi.py (1e-9 relative).
+compared with the tolerance of tests/mpi/test_mpi.py (1e-9 relative).
 """
 
 import os
@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from mpi4py import MPI
-from test_io import SECTION, rollup_model
+from scenekit import SECTION, rollup_model
 
 from beamfx.analyses.static import solve_static
 from beamfx.io import FrameWriter, OutputSettings

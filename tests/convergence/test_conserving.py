@@ -5,7 +5,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from test_transient import CLAMP, RHO, E, G, flying_spaghetti, hat
+from scenekit import CLAMP, RHO, E, G, flying_spaghetti, hat
 
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static

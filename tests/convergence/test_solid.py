@@ -8,6 +8,8 @@ import pytest
 
 pytest.importorskip("gmsh")
 
+from scenekit import SOLID_SCENE
+
 from beamfx.bench import schwab_meijaard_2009 as sm
 from beamfx.bench._builders import straight
 from beamfx.geometry import Arc
@@ -16,34 +18,10 @@ from beamfx.scene import SceneError
 from beamfx.solid.geometry import SolidMesh, SweepError, check_sweep
 from beamfx.spec import Beam
 
-SCENE = """
-[material]
-E = 2.1e11
-nu = 0.3
-
-[[beams]]
-name = "b"
-curve = {curve}
-section = {section}
-elements = 2
-degree = 3
-
-[[supports]]
-at = "b:start"
-fix = "all"
-
-[[loads]]
-at = "b:end"
-force = [0, 0, 1e4]
-
-[analysis]
-type = "linear_static"
-"""
-
 
 def _scene(tmp_path, curve, section):
     path = tmp_path / "scene.toml"
-    path.write_text(textwrap.dedent(SCENE.format(curve=curve, section=section)))
+    path.write_text(textwrap.dedent(SOLID_SCENE.format(curve=curve, section=section)))
     return path
 
 

@@ -115,7 +115,7 @@ def test_planar_transient_spin_up_agrees_with_the_full_model():
     from beamfx.analyses.transient import solve_transient
     from beamfx.io.probes import evaluate_points
 
-    text = (Path(__file__).parents[1] / "demos/scenes/spin_up.toml").read_text()
+    text = (Path(__file__).parents[2] / "demos/scenes/spin_up.toml").read_text()
     text = text.replace('plane = "xy"', "").replace("t_end = 18.0", "t_end = 4.0")
     differences = []
     text = text.replace("dt = 0.0125", "dt = 0.1")
@@ -141,7 +141,7 @@ def test_planar_transient_spin_up_agrees_with_the_full_model():
     ],
 )
 def test_3d_scenes_keep_the_full_model(edits, why):
-    text = (Path(__file__).parents[1] / "beamfx/scenes/bend45.toml").read_text()
+    text = (Path(__file__).parents[2] / "beamfx/scenes/bend45.toml").read_text()
     if edits:  # a plane problem (in-plane load), but a modal analysis
         text = text.replace("force = [0, 0, 600]", "force = [600, 0, 0]")
     sc = scene(text, **edits)

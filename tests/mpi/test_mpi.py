@@ -66,11 +66,7 @@ def test_modal_and_buckling_match_serial():
 def test_transient_matches_serial():
     """A short transient of a 3D cantilever (quaternions, generalized-α, a load pulse): the
     tip after 40 steps is the same from 1 and 2 ranks (Newton converges to ~1e-10)."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).parent))
-    from test_transient import cantilever
+    from scenekit import cantilever
 
     from beamfx.analyses.transient import TransientSettings, solve_transient
 
@@ -167,7 +163,7 @@ def _docs_scene(analysis):
     import re
     from pathlib import Path
 
-    text = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
+    text = (Path(__file__).resolve().parents[2] / "docs" / "scenes.md").read_text()
     for body in re.findall(r"^```toml\n(.*?)^```$", text, re.MULTILINE | re.DOTALL):
         if re.search(rf'^type = "{analysis}"', body, re.MULTILINE) and "[[sweep]]" not in body:
             return body

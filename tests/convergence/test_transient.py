@@ -5,6 +5,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scenekit import CLAMP, RHO, E, G, cantilever, flying_spaghetti
 
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
@@ -17,27 +18,6 @@ from beamfx.physics.sections import tube
 from beamfx.scene import SceneError
 from beamfx.scene.load import parse_scene
 from beamfx.spec import Beam, Model, PointLoad, Support
-
-E, G, RHO = 210e9, 80.77e9, 7850.0
-CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")
-
-
-def pulse(t):
-    """A smooth pulse on [0, 0.05] s: zero value and slope at both ends."""
-    t = np.asarray(t, float)
-    return np.where(t < 0.05, 0.5 * (1 - np.cos(2 * np.pi * t / 0.05)), 0.0)
-
-
-def cantilever(history=pulse, force=(0.0, 300.0, 400.0), elements=2, degree=2, kin=None):
-    """Steel tube cantilever, 1 m, first bending period about 0.07 s; 3D, quaternions."""
-    section = tube(E, G, RHO, 0.02)
-    beam = Beam("b", Line((0, 0, 0), (1.0, 0, 0)), section, elements, degree)
-    return Model(
-        (beam,),
-        (Support("b:start", CLAMP),),
-        (PointLoad("b:end", force, (0.0, 0.0, 0.0), "dead", history),),
-        kinematics=kin or Kinematics(),
-    )
 
 
 def tip_after(model, settings):
@@ -218,23 +198,6 @@ def test_a_step_newton_cannot_take_stops_cleanly(tmp_path):
     with pytest.raises(TransientFailed, match=r"(?s)from t = 0\b.*dt_min.*residuals"):
         solve_transient(model, settings, options={"snes_max_it": 2}, checkpoint_dir=tmp_path)
     assert list(tmp_path.glob("checkpoint_*.npz"))
-
-
-def hat(t):
-    """The load pulse of the flying spaghetti: 0 → 1 at 2.5 s → 0 at 5 s."""
-    t = np.asarray(t, float)
-    return np.clip(np.where(t < 2.5, t / 2.5, (5 - t) / 2.5), 0.0, None)
-
-
-def flying_spaghetti(elements=8, degree=2):
-    """Simo & Vu-Quoc (1986), planar: a free beam from (6, 0) to (0, 8) thrown by a force 8
-    along x and a moment 80 about z at its lower end, both with the hat pulse."""
-    from beamfx.physics.sections import Section
-
-    section = Section(1e4, 1e4, 1e4, 500.0, 500.0, 500.0, 1.0, (20.0, 10.0, 10.0))
-    beam = Beam("b", Line((6, 0, 0), (0, 8, 0)), section, elements, degree)
-    load = PointLoad("b:start", (8.0, 0.0, 0.0), (0.0, 0.0, 80.0), "dead", hat)
-    return Model((beam,), (), (load,), kinematics=Kinematics(plane="xy"))
 
 
 @pytest.mark.parametrize("rho_inf", [1.0, 0.8])

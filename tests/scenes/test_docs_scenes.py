@@ -14,7 +14,7 @@ import pytest
 from beamfx.runner import check_scene, run_scene
 from beamfx.scene import SceneError
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "scenes.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "scenes.md"
 FENCE = re.compile(r"^```([\w-]*)\n(.*?)^```$", re.MULTILINE | re.DOTALL)
 
 

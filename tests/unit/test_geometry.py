@@ -19,7 +19,7 @@ from beamfx.geometry import (
 )
 from beamfx.solvers import compile_form
 
-MESHES = Path(__file__).parent.parent / "meshes"
+MESHES = Path(__file__).parents[2] / "meshes"
 ARC = Arc((0, 0, 0), (1, 0, 0), (0, 1, 0), 90.0)
 
 

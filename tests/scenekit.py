@@ -1,0 +1,113 @@
+"""Scenes and models shared by tests of several folders (importable as ``scenekit``)."""
+
+import numpy as np
+from mpi4py import MPI
+
+from beamfx.analyses.model import BeamModel
+from beamfx.geometry import Line
+from beamfx.physics.kinematics import Kinematics
+from beamfx.physics.sections import Section, tube
+from beamfx.spec import Beam, Model, PointLoad, Support
+
+E, G, RHO = 210e9, 80.77e9, 7850.0
+CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")
+
+# A clamped steel strip shaken at its root (analysis type replaced by the test)
+SHAKEN = """
+[material]
+E = 210e9
+nu = 0.3
+rho = 7850
+[[beams]]
+name = "arm"
+curve = { shape = "line", start = [0, 0, 0], end = [0, 0, 0.5] }
+section = { type = "rectangle", h = 0.002, w = 0.03 }
+elements = 4
+[[supports]]
+at = "arm:start"
+fix = "all"
+displacement = [0.02, 0, 0]
+history = "(1 - cos(pi * t / 0.2)) / 2"
+[analysis]
+type = "ANALYSIS"
+[[probes]]
+name = "tip"
+at = "arm:end"
+"""
+
+# The linear cantilever of the 3D solid, curve and section filled in by the test
+SOLID_SCENE = """
+[material]
+E = 2.1e11
+nu = 0.3
+
+[[beams]]
+name = "b"
+curve = {curve}
+section = {section}
+elements = 2
+degree = 3
+
+[[supports]]
+at = "b:start"
+fix = "all"
+
+[[loads]]
+at = "b:end"
+force = [0, 0, 1e4]
+
+[analysis]
+type = "linear_static"
+"""
+
+# The roll-up of a straight cantilever under an end moment (``turns`` full turns)
+comm = MPI.COMM_WORLD
+L, EI = 10.0, 215e3
+SECTION = Section(EA=1770e3, GA_y=1770e3, GA_z=1770e3, GJ=8.16e3, EI_y=EI, EI_z=EI)
+ELEMENTS, DEGREE = 8, 3
+# tip error of this mesh in the two-turn roll-up is 1.4e-5 L (notes §11), at half a turn 5e-10 L;
+# the stress resultants converge at O(h^4) and are off by 3e-6 here
+TOL_POSITION, TOL_MOMENT = 1e-5, 1e-5
+
+
+def rollup_model(turns, comm=comm):
+    M = turns * 2 * np.pi * EI / L
+    spec = Model(
+        beams=(Beam("b", Line((0, 0, 0), (L, 0, 0)), SECTION, ELEMENTS, DEGREE),),
+        supports=(Support("b:start", ("ux", "uy", "uz", "rx", "ry", "rz")),),
+        point_loads=(PointLoad("b:end", moment=(0, -M, 0)),),
+    )
+    return BeamModel(spec, comm), M
+
+
+def hat(t):
+    """The load pulse of the flying spaghetti: 0 → 1 at 2.5 s → 0 at 5 s."""
+    t = np.asarray(t, float)
+    return np.clip(np.where(t < 2.5, t / 2.5, (5 - t) / 2.5), 0.0, None)
+
+
+def flying_spaghetti(elements=8, degree=2):
+    """Simo & Vu-Quoc (1986), planar: a free beam from (6, 0) to (0, 8) thrown by a force 8
+    along x and a moment 80 about z at its lower end, both with the hat pulse."""
+    section = Section(1e4, 1e4, 1e4, 500.0, 500.0, 500.0, 1.0, (20.0, 10.0, 10.0))
+    beam = Beam("b", Line((6, 0, 0), (0, 8, 0)), section, elements, degree)
+    load = PointLoad("b:start", (8.0, 0.0, 0.0), (0.0, 0.0, 80.0), "dead", hat)
+    return Model((beam,), (), (load,), kinematics=Kinematics(plane="xy"))
+
+
+def pulse(t):
+    """A smooth pulse on [0, 0.05] s: zero value and slope at both ends."""
+    t = np.asarray(t, float)
+    return np.where(t < 0.05, 0.5 * (1 - np.cos(2 * np.pi * t / 0.05)), 0.0)
+
+
+def cantilever(history=pulse, force=(0.0, 300.0, 400.0), elements=2, degree=2, kin=None):
+    """Steel tube cantilever, 1 m, first bending period about 0.07 s; 3D, quaternions."""
+    section = tube(E, G, RHO, 0.02)
+    beam = Beam("b", Line((0, 0, 0), (1.0, 0, 0)), section, elements, degree)
+    return Model(
+        (beam,),
+        (Support("b:start", CLAMP),),
+        (PointLoad("b:end", force, (0.0, 0.0, 0.0), "dead", history),),
+        kinematics=kin or Kinematics(),
+    )
