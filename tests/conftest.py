@@ -1,4 +1,5 @@
 import os
+import textwrap
 
 os.environ.setdefault("SETUPTOOLS_USE_DISTUTILS", "stdlib")
 
@@ -30,3 +31,15 @@ def value_at(model, sub, xyz):
 @pytest.fixture
 def tmp_out(tmp_path):
     return tmp_path / "out"
+
+
+@pytest.fixture
+def scene_file(tmp_path):
+    """Write a scene text into the test's folder: ``scene_file(text, name="scene.toml") -> Path``."""
+
+    def write(text, name="scene.toml"):
+        path = tmp_path / name
+        path.write_text(textwrap.dedent(text))
+        return path
+
+    return write

@@ -1,8 +1,6 @@
 """The 3D solid of a beam: a coarse linear cantilever against beam theory, the face fit, and
 the bad-input errors."""
 
-import textwrap
-
 import numpy as np
 import pytest
 
@@ -19,10 +17,8 @@ from beamfx.solid.geometry import SolidMesh, SweepError, check_sweep
 from beamfx.spec import Beam
 
 
-def _scene(tmp_path, curve, section):
-    path = tmp_path / "scene.toml"
-    path.write_text(textwrap.dedent(SOLID_SCENE.format(curve=curve, section=section)))
-    return path
+def _scene(scene_file, curve, section):
+    return scene_file(SOLID_SCENE.format(curve=curve, section=section))
 
 
 def test_coarse_cantilever_matches_beam_theory():
@@ -73,12 +69,12 @@ def test_tight_arc_cannot_be_swept():
     check_sweep(beam, SolidMesh())
 
 
-def test_tight_arc_error_names_file_and_key(tmp_path):
+def test_tight_arc_error_names_file_and_key(tmp_path, scene_file):
     from beamfx.scene import load_scene
     from beamfx.solid.run import build, spec_from_scene
 
     path = _scene(
-        tmp_path,
+        scene_file,
         '{ shape = "arc", start = [0, 0, 0], start_tangent = [1, 0, 0], centre = [0, 0, 0.05], angle_deg = 90 }',
         '{ type = "rectangle", h = 0.2, w = 0.1 }',
     )
@@ -87,12 +83,12 @@ def test_tight_arc_error_names_file_and_key(tmp_path):
         build(spec, str(path))
 
 
-def test_too_coarse_section_names_the_option(tmp_path):
+def test_too_coarse_section_names_the_option(tmp_path, scene_file):
     from beamfx.scene import load_scene
     from beamfx.solid.run import build, spec_from_scene
 
     path = _scene(
-        tmp_path,
+        scene_file,
         '{ shape = "line", start = [0, 0, 0], end = [1, 0, 0] }',
         '{ type = "circle", d = 0.02 }',
     )

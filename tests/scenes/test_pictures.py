@@ -59,10 +59,8 @@ def _assert_shows_a_beam(path, size=pictures.SIZE):
     assert frame.std() > 5, path
 
 
-def _scene(tmp_path, analysis, keys):
-    path = tmp_path / "scene.toml"
-    path.write_text(SHAKEN.replace('"ANALYSIS"', f'"{analysis}"\n{keys}'))
-    return path
+def _scene(scene_file, analysis, keys):
+    return scene_file(SHAKEN.replace('"ANALYSIS"', f'"{analysis}"\n{keys}'))
 
 
 def test_picture_plan_names_one_picture_per_mode_and_the_gif_of_a_transient():
@@ -86,10 +84,10 @@ def test_picture_plan_names_one_picture_per_mode_and_the_gif_of_a_transient():
         ("transient", "t_end = 0.1\ndt = 0.01\noutput_every = 2", ["deformed.png"]),
     ],
 )
-def test_pictures_of_modes_and_of_a_transient(tmp_path, analysis, keys, files):
+def test_pictures_of_modes_and_of_a_transient(tmp_path, analysis, keys, files, scene_file):
     messages = []
     out = tmp_path / "out"
-    results = run_scene(_scene(tmp_path, analysis, keys), out, log=_quiet(messages), png=True)
+    results = run_scene(_scene(scene_file, analysis, keys), out, log=_quiet(messages), png=True)
     assert results["pictures"] == {"written": files, "skipped": {}}
     assert (out / "undeformed.vtu").is_file()
     for name in files:
@@ -99,10 +97,12 @@ def test_pictures_of_modes_and_of_a_transient(tmp_path, analysis, keys, files):
 
 @needs_pyvista
 @pytest.mark.skipif(find_spec("imageio") is None, reason="imageio not installed")
-def test_animation_of_a_transient(tmp_path):
+def test_animation_of_a_transient(tmp_path, scene_file):
     out = tmp_path / "out"
     keys = "t_end = 0.1\ndt = 0.01\noutput_every = 2"
-    results = run_scene(_scene(tmp_path, "transient", keys), out, log=lambda m: None, animate=True)
+    results = run_scene(
+        _scene(scene_file, "transient", keys), out, log=lambda m: None, animate=True
+    )
     assert results["pictures"]["written"] == ["deformed.png", "animation.gif"]
     frames = _image(out / "animation.gif")
     assert len(frames) >= 6  # t = 0, 0.02, ..., 0.1
@@ -120,11 +120,13 @@ def test_a_beam_without_section_outline_is_drawn_as_its_centre_line(tmp_path):
     _assert_shows_a_beam(out / "deformed.png")
 
 
-def test_without_pyvista_the_run_says_which_pictures_it_skipped(tmp_path, monkeypatch):
+def test_without_pyvista_the_run_says_which_pictures_it_skipped(tmp_path, monkeypatch, scene_file):
     monkeypatch.setitem(sys.modules, "pyvista", None)  # import pyvista -> ImportError
     messages = []
     out = tmp_path / "out"
-    results = run_scene(_scene(tmp_path, "modal", "modes = 2"), out, log=_quiet(messages), png=True)
+    results = run_scene(
+        _scene(scene_file, "modal", "modes = 2"), out, log=_quiet(messages), png=True
+    )
     assert len(results["frequencies_hz"]) == 2  # the solve ran
     assert (out / "results.json").is_file()
     skipped = results["pictures"]["skipped"]

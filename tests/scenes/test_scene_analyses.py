@@ -30,17 +30,15 @@ dir = "{out}"
 """
 
 
-def _run(tmp_path, text):
-    scene = tmp_path / "scene.toml"
-    scene.write_text(text)
-    return run_scene(scene, log=lambda *a: None)
+def _run(scene_file, text):
+    return run_scene(scene_file(text), log=lambda *a: None)
 
 
-def test_modal_scene_gives_the_euler_bernoulli_cantilever_frequencies(tmp_path):
+def test_modal_scene_gives_the_euler_bernoulli_cantilever_frequencies(tmp_path, scene_file):
     EI, rho_A, L = 1e4, 2.0, 2.0
     text = CANTILEVER.format(EI=EI, rho_A=rho_A, out=tmp_path / "out")
     results = _run(
-        tmp_path, text + '[analysis]\ntype = "modal"\nmodes = 4\nrotary_inertia = "none"\n'
+        scene_file, text + '[analysis]\ntype = "modal"\nmodes = 4\nrotary_inertia = "none"\n'
     )
     f = np.array(results["frequencies_hz"])
     beta = np.array([1.8751040687, 4.6940911330])
@@ -55,24 +53,24 @@ def test_modal_scene_gives_the_euler_bernoulli_cantilever_frequencies(tmp_path):
     assert (tmp_path / "out" / "deformed_0004.vtu").is_file()  # one ParaView step per mode
 
 
-def test_buckling_scene_gives_the_euler_load(tmp_path):
+def test_buckling_scene_gives_the_euler_load(tmp_path, scene_file):
     EI, L = 1e4, 2.0
     text = CANTILEVER.format(EI=EI, rho_A=0.0, out=tmp_path / "out").replace("shear = false", "")
     text += (
         '[[loads]]\nat = "b:end"\nforce = [-1, 0, 0]\n\n[analysis]\ntype = "buckling"\nmodes = 2\n'
     )
-    results = _run(tmp_path, text)
+    results = _run(scene_file, text)
     GA = 1e8
     euler = np.pi**2 * EI / (4 * L**2) * np.array([1, 4])  # EI_z = 4 EI_y
     engesser = euler / (1 + euler / GA)  # shear-flexible column (P/EA = 3e-8 is left out)
     assert np.allclose(results["load_factors"], engesser, rtol=1e-6), results["load_factors"]
 
 
-def test_modal_scene_without_mass_is_an_error(tmp_path):
+def test_modal_scene_without_mass_is_an_error(tmp_path, scene_file):
     import pytest
 
     text = CANTILEVER.format(EI=1e4, rho_A=0.0, out=tmp_path / "out").replace(
         "rho_I = [1e-6, 1e-6, 1e-6]", "rho_I = [0, 0, 0]"
     )
     with pytest.raises(ValueError, match="needs mass"):
-        _run(tmp_path, text + '[analysis]\ntype = "modal"\n')
+        _run(scene_file, text + '[analysis]\ntype = "modal"\n')
