@@ -127,9 +127,9 @@ def _prepare(out, scene, comm, named_by_scene):
 
 def _refine(scene, comm, log):
     """The scene with the elements and degree that meet its ``[accuracy]``, if it has one."""
-    from .analyses.checks import check_supported
+    from .analyses.checks import check_supports_for
 
-    check_supported(scene.model)
+    check_supports_for(scene.model, scene.settings)
     if not scene.accuracy:
         return scene, None
     from .analyses.adaptive import refine_to_tolerance
@@ -253,10 +253,10 @@ def _finish(run, out, scene, refinement, log, comm, png, animate):
 def check_scene(path: str | os.PathLike):
     """Validate a scene without solving: keys, types, points, supports; for a sweep file every
     member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
-    from .analyses.checks import check_supported
+    from .analyses.checks import check_supports_for
     from .scene import Sweep, load_scene_or_sweep
 
     loaded = load_scene_or_sweep(path)
     for scene in [m.scene for m in loaded.members] if isinstance(loaded, Sweep) else [loaded]:
-        check_supported(scene.model)
+        check_supports_for(scene.model, scene.settings)
     return loaded

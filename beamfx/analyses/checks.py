@@ -154,6 +154,14 @@ def check_supported(model):
         )
 
 
+def check_supports_for(model, settings):
+    """:func:`check_supported`, unless the analysis takes a free structure: its settings say so
+    with ``free_body(model) -> bool`` (a modal analysis without pre-stress, a transient from
+    rest: their operators K - ω²M and M/(β Δt²) + K are regular)."""
+    if not getattr(settings, "free_body", lambda model: False)(model):
+        check_supported(model)
+
+
 def check_planar(model):
     """Raise ValueError if a planar model's geometry or loads leave its plane."""
     from ..physics.kinematics import PLANES

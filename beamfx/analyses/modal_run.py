@@ -23,6 +23,15 @@ class Settings:
     prestress: bool = option(True, doc="about the static state under the scene's loads")
     steps: int = option(10, positive=True, doc="load steps of the pre-stressing solve")
 
+    def free_body(self, model):
+        """A structure without supports has its rigid-body modes at 0 Hz; only pre-stress
+        (a static solve) needs supports."""
+        return not (self.prestress and _loaded(model))
+
+
+def _loaded(model):
+    return bool(model.point_loads or model.distributed_loads or any(model.gravity))
+
 
 @dataclass(frozen=True, kw_only=True)
 class Result(_Base):
@@ -32,6 +41,7 @@ class Result(_Base):
     effective_mass: tuple = entry("effective modal masses per mode and global direction")
     omega_rad_s: tuple = entry("circular frequencies (rad/s)")
     prestressed: bool = entry("solved about a loaded static state")
+    rigid_body_modes: int = entry("how many of the first modes are free rigid-body motions")
     mode_shapes: tuple = entry("each mode's displacement at the probes (largest nodal = 1)")
     paraview_steps: str = entry("what the ParaView frames hold")
 
@@ -46,7 +56,7 @@ def run(model, settings, ctx):
 
     ctx.require_mass(model, "modal")
     spec, steps = ctx.spec, ()
-    if settings.prestress and (spec.point_loads or spec.distributed_loads or any(spec.gravity)):
+    if settings.prestress and _loaded(spec):
         steps = prestress(
             model, settings.steps, ctx, "pre-stress: static solve under the scene's loads"
         )
@@ -55,8 +65,10 @@ def run(model, settings, ctx):
     res = solve_modes(
         model, settings.modes, target, rotary=settings.rotary_inertia, options=ctx.solver_options
     )
+    rigid = _rigid_modes(spec, settings, res.omega)
     for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
-        ctx.log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s)")
+        kind = " rigid-body (0 Hz to round-off)" if i <= rigid else ""
+        ctx.log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s){kind}")
     m_eff = effective_masses(model, res.modes, settings.rotary_inertia)
     return Result(
         analysis=ctx.analysis,
@@ -67,9 +79,21 @@ def run(model, settings, ctx):
         effective_mass=tuple(m_eff.tolist()),
         omega_rad_s=tuple(res.omega.tolist()),
         prestressed=bool(steps),
+        rigid_body_modes=rigid,
         mode_shapes=shapes(model, res.modes, ctx),
         paraview_steps=PARAVIEW_STEPS,
     )
+
+
+def _rigid_modes(spec, settings, omega):
+    """How many of the first modes are free rigid-body motions: at most as many as the
+    supports leave free, looking from 0 Hz, and each below 1e-2 of the highest frequency found
+    (a rigid rotation without rotary inertia has no finite frequency and is not among them)."""
+    from .checks import free_rigid_modes
+
+    free = free_rigid_modes(spec) if settings.target_hz == 0 else 0
+    top = np.max(np.abs(omega), initial=0.0)
+    return int(np.sum(np.abs(omega[:free]) < 1e-2 * top))
 
 
 ANALYSES = (Analysis("modal", Settings, run, plane=False, doc="natural frequencies and modes"),)

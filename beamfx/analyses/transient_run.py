@@ -57,6 +57,11 @@ class Settings:
     start: str = option("rest", choices=("rest", "static"), doc="from rest or a static state")
     steps: int = option(10, positive=True, doc="load steps of a static start")
 
+    def free_body(self, model):
+        """A free structure may fly from rest (the mass makes the step's operator regular);
+        a static start needs supports."""
+        return self.start == "rest"
+
     @property
     def frames_every(self):
         """Frames every this many steps, unless ``[output]`` says otherwise."""

@@ -137,13 +137,14 @@ def plane_fit(model, plane, settings=None):
     return None
 
 
-def choose_plane(model, analysis, settings=None):
+def choose_plane(model, analysis, settings=None, free_body=False):
     """The plane in which ``model`` (a full 3D :class:`~beamfx.spec.Model`) is a plane
     problem for ``analysis``, as a :class:`Trim`; ``plane`` None where it is not (or where the
-    analysis needs out-of-plane motion, :data:`NEVER_TRIMMED`)."""
+    analysis needs out-of-plane motion, :data:`NEVER_TRIMMED`). ``free_body``: the analysis
+    takes a free structure (then free rigid-body motion does not keep the full model)."""
     if analysis in NEVER_TRIMMED:
         return Trim(None, True, f"full model: a {analysis} analysis has out-of-plane modes")
-    if free_rigid_modes(model):
+    if free_rigid_modes(model) and not free_body:
         return Trim(None, True, "full model: the supports leave 3D rigid-body motion free")
     reasons = []
     for plane in PLANES:

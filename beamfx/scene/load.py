@@ -347,6 +347,11 @@ def parse_scene(data, file="<scene>", base=Path(".")):
         point_masses=tuple(masses),
     )
     _check_points(model, probes, file)
+    if not model.supports and not getattr(settings, "free_body", lambda m: False)(model):
+        raise SceneError(
+            f"{file}: supports: none given; the structure is free (rigid-body motion), which "
+            "only a modal analysis without pre-stress or a transient from rest can take"
+        )
     model, trimming = _trim(model, plane, analysis, settings)
     if condense == "auto":
         from ..analyses.trimming import condensed_fit
@@ -534,7 +539,8 @@ def _trim(model, plane, analysis, settings):
     if not analysis.plane:
         why = f"full model: a {analysis.name} analysis has out-of-plane modes"
         return model, Trim(None, True, why)
-    trim = choose_plane(model, analysis.name, asdict(settings))
+    free_body = getattr(settings, "free_body", lambda model: False)(model)
+    trim = choose_plane(model, analysis.name, asdict(settings), free_body)
     if trim.plane:
         model = replace(model, kinematics=replace(model.kinematics, plane=trim.plane))
     return model, trim
@@ -607,8 +613,6 @@ def _check_points(model, probes, file):
             raise SceneError(
                 f"{file}: loads.beam: {d.beam!r} is no beam; beams are {[b.name for b in model.beams]}"
             )
-    if not model.supports:
-        raise SceneError(f"{file}: supports: none given; the structure is free (rigid-body motion)")
 
 
 def _check_orientation(beam, where):
