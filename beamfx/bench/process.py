@@ -26,8 +26,13 @@ def main(argv):
     from . import all_cases
     from .scenes import case_scene
 
-    scene = case_scene(all_cases()[case_id], int(elements), int(degree))
-    run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)
+    case = all_cases()[case_id]
+    if hasattr(case, "scenes"):  # a case of several scenes (eigen analyses)
+        scenes = case.scenes(int(elements), int(degree))
+    else:
+        scenes = [case_scene(case, int(elements), int(degree))]
+    for scene in scenes:
+        run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)
 
 
 if __name__ == "__main__":

@@ -263,10 +263,11 @@ def markdown(results, figures=None, note=None):
             "cache, second run in the process; **process** = `beamfx run` of the cheapest "
             "setting as a process of its own, interpreter start and imports included "
             "(`python -m beamfx.bench.process`); **solve only** = the Newton iterations' own "
-            "time (assembly, linear solves, SNES) inside that run, labelled as such; cold = the "
-            "first run in the process (JIT or cache load included). Cases marked * still run "
-            "their own solver path (eigen, rotating, transient and adaptive cases): their "
-            "times are solve-only."
+            "time (assembly, linear solves, SNES; for eigen cases the eigen assembly and "
+            "solve) inside that run, labelled as such; cold = the first run in the process (JIT "
+            "or cache load included). A setting of several runs (one per target frequency or "
+            "load) sums them. Cases marked * still run their own solver path (torque buckling, "
+            "rotating, transient and adaptive cases): their times are solve-only."
         ),
         "",
         (

@@ -63,17 +63,75 @@ class EigenCase(Case):
         }
 
 
+@dataclass(frozen=True)
+class SceneEigenCase(Case):
+    """A case whose setting is one or more eigen analyses run as scenes: ``build(elements,
+    degree)`` returns ``[(scene, read)]``, ``read(result)`` the named values of a run's result.
+    :meth:`run_setting` runs them through ``beamfx run``'s path (cold, then warm)."""
+
+    def scenes(self, elements, degree):
+        """The scenes of one setting, for a process of their own (:mod:`.process`)."""
+        return [scene for scene, _ in self.build(elements, degree)]
+
+    def run_setting(self, elements, degree):
+        """Cold and warm whole runs of the setting's scenes; solve only = the eigen (and
+        pre-stress Newton) assembly and solves."""
+        import tempfile
+
+        from ..solvers.forms import compile_seconds
+        from .scenes import run_scenes
+
+        c0 = compile_seconds[0]
+        with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
+            _, cold, _ = run_scenes(self.build(elements, degree), folder)
+            jit = compile_seconds[0] - c0
+            runs, warm, values = run_scenes(self.build(elements, degree), folder)
+        solve = sum(
+            r.result.seconds.get("assemble", 0.0) + r.result.seconds.get("solve", 0.0) for r in runs
+        )
+        return {
+            "elements": elements,
+            "degree": degree,
+            "unknowns": runs[0].model["unknowns"],
+            "newton_iterations": sum(r.result.newton_iterations for r in runs),
+            "load_steps": sum(len(r.result.load_steps) for r in runs),
+            "wall_s_cold": cold,
+            "wall_s_whole": warm,
+            "wall_s_warm": solve,
+            "jit_s": jit,
+            "warm_split_s": {},
+            "values": {k: float(v) for k, v in self.measure(values).items()},
+        }
+
+
 def _same(values):
     return values
 
 
-def _buckling(model_spec, n_modes=1):
+def _buckling_solve(model_spec, n_modes=1):
+    """The buckling load factors and unknowns of ``model_spec`` (own path, not a scene)."""
     from ..analyses.buckling import solve_buckling
     from ..analyses.model import BeamModel
 
     model = BeamModel(model_spec)
     r = solve_buckling(model, n_modes=n_modes, prefix="beamfx_bench_buckling_")
     return r.load_factors, model.unknowns()
+
+
+def _buckling(case_id, model_spec, name, scale):
+    """One linear buckling scene: ``{name: λ₁ / scale}``."""
+    from .scenes import analysis_scene
+
+    scene = analysis_scene(case_id, model_spec, "buckling", modes=1)
+    return [(scene, lambda r: {name: r.load_factors[0] / scale})]
+
+
+def _modal(case_id, model_spec, name, scale, **settings):
+    """One modal scene: ``{name: ω₁ / scale}`` (rad/s over rad/s)."""
+    from .scenes import analysis_scene
+
+    scene = analysis_scene(case_id, model_spec, "modal", modes=1, **settings)
+    return [(scene, lambda r: {name: r.omega_rad_s[0] / scale})]
 
 
 SETTINGS = tuple((n, p) for p in (2, 3, 4) for n in (1, 2, 4, 8))
@@ -87,12 +145,11 @@ F_TH_25 = np.pi**2 / 4 * min(S25.EI_y, S25.EI_z) / L25**2
 
 def _euler(n, p):
     spec = cantilever(straight(L25), stiffened(S25, stretch=False), n, p, force=(-1.0, 0, 0))
-    lam, dofs = _buckling(spec)
-    return {"F_cr/F_th": lam[0] / F_TH_25}, dofs, 0
+    return _buckling("sm25_euler_buckling", spec, "F_cr/F_th", F_TH_25)
 
 
 register(
-    EigenCase(
+    SceneEigenCase(
         "sm25_euler_buckling",
         "Schwab & Meijaard 2009, 2.5",
         "Euler buckling of a cantilever, linear buckling analysis",
@@ -119,12 +176,11 @@ def _lateral(n, p):
     spec = cantilever(
         straight(P26["geometry"]["L"]), stiffened(S26, stretch=False), n, p, force=(0, 0, 1.0)
     )
-    lam, dofs = _buckling(spec)
-    return {"F_cr/F_th": lam[0] / F_TH_26}, dofs, 0
+    return _buckling("sm26_lateral_buckling", spec, "F_cr/F_th", F_TH_26)
 
 
 register(
-    EigenCase(
+    SceneEigenCase(
         "sm26_lateral_buckling",
         "Schwab & Meijaard 2009, 2.6",
         "Lateral (flexural-torsional) buckling of a cantilever under a tip force",
@@ -153,21 +209,25 @@ THEORY_28 = {
 
 
 def _free_free(n, p):
-    from ..analyses.modal import solve_modes
-    from ..analyses.model import BeamModel
-
-    beam = Beam("b", straight(L28), S28, n, p)
-    model = BeamModel(Model(beams=(beam,), kinematics=Kinematics(shear=False)))
-    omega = {}
-    for name, ref in THEORY_28.items():
-        # the mode nearest the theory value: shift-invert there (bending comes in pairs)
-        r = solve_modes(model, 1, target=ref**2, rotary="polar", prefix="beamfx_bench_modal_")
-        omega[name] = r.omega[0]
-    return omega, model.unknowns(), 0
+    """One modal scene per theory frequency: the mode nearest it (``target_hz``; bending comes
+    in pairs, and the six rigid-body modes sit at 0)."""
+    spec = Model(beams=(Beam("b", straight(L28), S28, n, p),), kinematics=Kinematics(shear=False))
+    return [
+        run
+        for name, ref in THEORY_28.items()
+        for run in _modal(
+            "sm28_free_free_eigen",
+            spec,
+            name,
+            1.0,
+            target_hz=ref / (2 * np.pi),
+            rotary_inertia="polar",
+        )
+    ]
 
 
 register(
-    EigenCase(
+    SceneEigenCase(
         "sm28_free_free_eigen",
         "Schwab & Meijaard 2009, 2.8",
         "Free-free beam: axial, torsional and first two bending frequencies",
@@ -186,15 +246,14 @@ register(
 def _free_free_timoshenko(n, p):
     """The 2.8 beam with its shear flexibility and full rotary inertia (Timoshenko bending):
     each frequency divided by its Euler-Bernoulli theory value."""
-    from ..analyses.modal import solve_modes
-    from ..analyses.model import BeamModel
-
-    model = BeamModel(Model(beams=(Beam("b", straight(L28), S28, n, p),)))
-    ratio = {}
-    for name, ref in THEORY_28.items():
-        r = solve_modes(model, 1, target=ref**2, rotary="full", prefix="beamfx_bench_modal_")
-        ratio[name + "/EB"] = r.omega[0] / ref
-    return ratio, model.unknowns(), 0
+    spec = Model(beams=(Beam("b", straight(L28), S28, n, p),))
+    return [
+        run
+        for name, ref in THEORY_28.items()
+        for run in _modal(
+            "sm28_free_free_timoshenko", spec, name + "/EB", ref, target_hz=ref / (2 * np.pi)
+        )
+    ]
 
 
 # first-order Timoshenko correction of a free-free bending frequency:
@@ -206,7 +265,7 @@ _DROP = {
 }
 
 register(
-    EigenCase(
+    SceneEigenCase(
         "sm28_free_free_timoshenko",
         "Schwab & Meijaard 2009, 2.8 (Timoshenko)",
         "Free-free beam with shear and rotary inertia: frequencies / Euler-Bernoulli theory",
@@ -250,23 +309,25 @@ def pinned_in_tension(section, L, F, n, p):
 
 
 def _prestressed(n, p):
-    from ..analyses.modal import solve_modes
-    from ..analyses.model import BeamModel
-    from ..analyses.static import solve_static
-
-    ratios, its, dofs = {}, 0, 0
+    """One pre-stressed modal scene per α: the static solve under F in one step, then the
+    first mode about that state."""
+    runs = []
     for alpha in P29["alphas"]:
         F = alpha * np.pi**2 * S29.EI_y / L29**2
-        model = BeamModel(pinned_in_tension(S29, L29, F, n, p))
-        its += solve_static(model, steps=1, prefix="beamfx_bench_static_").newton_iterations
-        r = solve_modes(model, 1, rotary="polar", prefix="beamfx_bench_modal_")
-        ratios[f"alpha={alpha:g}"] = r.omega[0] / (W0_29 * np.sqrt(1 + alpha))
-        dofs = model.unknowns()
-    return ratios, dofs, its
+        spec = pinned_in_tension(S29, L29, F, n, p)
+        runs += _modal(
+            "sm29_prestressed",
+            spec,
+            f"alpha={alpha:g}",
+            W0_29 * np.sqrt(1 + alpha),
+            rotary_inertia="polar",
+            steps=1,
+        )
+    return runs
 
 
 register(
-    EigenCase(
+    SceneEigenCase(
         "sm29_prestressed",
         "Schwab & Meijaard 2009, 2.9",
         "Simply supported beam under tension F: first bending frequency",

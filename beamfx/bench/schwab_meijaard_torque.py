@@ -31,7 +31,7 @@ from ..physics import sections
 from ..spec import Beam, Model, PointLoad, Support
 from ._builders import CLAMP, straight
 from .registry import reference, register
-from .schwab_meijaard_eigen import FILE, NU, RHO, SETTINGS, E, EigenCase, G, _buckling, _same
+from .schwab_meijaard_eigen import FILE, NU, RHO, SETTINGS, E, EigenCase, G, _buckling_solve, _same
 
 P27 = reference(FILE, "sm27_torque_buckling")
 L27 = P27["geometry"]["L"]
@@ -60,7 +60,7 @@ def shaft(elements, degree, kind, torque=1.0, section=S27):
 def _torque(n, p):
     ratios, dofs = {}, 0
     for kind in CRITICAL:
-        factors, dofs = _buckling(shaft(n, p, kind))
+        factors, dofs = _buckling_solve(shaft(n, p, kind))
         ratios[kind] = factors[0] / M_TH_27
     return ratios, dofs, 0
 
