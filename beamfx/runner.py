@@ -33,9 +33,11 @@ class RunResult:
 
     @property
     def converged(self):
+        """Whether the analysis converged (its result's status)."""
         return self.result.status == "converged"
 
     def to_json(self):
+        """The content of results.json: scene, result, model, probes, wall time and outputs."""
         out = {"scene": self.scene, **self.result.to_json(), "model": self.model}
         if self.accuracy is not None:
             out["accuracy"] = self.accuracy
@@ -46,12 +48,14 @@ class RunResult:
 
     @cached_property
     def json(self):
+        """The results.json content, computed once."""
         return self.to_json()
 
     def __getitem__(self, key):
         return self.json[key]
 
     def get(self, key, default=None):
+        """Value of results.json key ``key``, or ``default``."""
         return self.json.get(key, default)
 
     def __contains__(self, key):

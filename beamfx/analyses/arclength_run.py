@@ -53,6 +53,7 @@ class Settings:
                 yield "control_point", str(e)
 
     def problems(self):
+        """(key, message) of contradictions between the keys: the trace needs a way to stop."""
         if self.target_load_factor is None and self.displacement_limit is None:
             yield "type", "arclength needs target_load_factor or displacement_limit to stop"
 
@@ -67,6 +68,7 @@ class Result(_Base):
     stopped_by: str = entry("target, stop (displacement limit) or max_steps")
 
     def summary(self):
+        """The numbers of a sweep table: the limit points and why the trace stopped."""
         return {"limit_points": list(self.limit_points), "stopped_by": self.stopped_by}
 
 

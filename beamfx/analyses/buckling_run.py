@@ -32,6 +32,7 @@ class Result(_Base):
     paraview_steps: str = entry("what the ParaView frames hold")
 
     def summary(self):
+        """The numbers of a sweep table: the critical load factors."""
         return {"load_factors": list(self.load_factors)}
 
 

@@ -46,6 +46,7 @@ class Result(_Base):
     paraview_steps: str = entry("what the ParaView frames hold")
 
     def summary(self):
+        """The numbers of a sweep table: the frequencies (Hz)."""
         return {"frequencies_hz": list(self.frequencies_hz)}
 
 

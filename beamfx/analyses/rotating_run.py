@@ -25,6 +25,7 @@ class Settings:
     steps: int = option(10, positive=True, doc="load steps of the first steady state")
 
     def problems(self):
+        """(key, message) of contradictions: a zero axis, no hub, both or neither speed key."""
         if not any(self.axis):
             yield "axis", "must not be zero"
         if self.hub is None:
@@ -68,6 +69,7 @@ class Result(_Base):
     steady_newton_iterations: tuple = entry("Newton iterations of each steady state")
 
     def summary(self):
+        """The numbers of a sweep table: the frequencies (Hz) and why the sweep stopped."""
         return {"frequencies_hz": list(self.frequencies_hz), "stopped_by": self.stopped_by}
 
 

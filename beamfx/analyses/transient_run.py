@@ -102,6 +102,7 @@ class Result(_Base):
     stopped_by: str = entry('"t_end" (a failed step raises, with its report)')
 
     def summary(self):
+        """The numbers of a sweep table: why the run ended and the number of time steps."""
         return {"stopped_by": self.stopped_by, "time_steps": self.time_steps}
 
 
@@ -194,10 +195,12 @@ class History:
         self.files[1].write(json.dumps(entry) + "\n")
 
     def flush(self):
+        """Flush the probe files (rank 0)."""
         for f in self.files or ():
             f.flush()
 
     def close(self):
+        """Close the probe files (rank 0)."""
         for f in self.files or ():
             f.close()
         self.files = None
