@@ -8,6 +8,13 @@ from dataclasses import dataclass, replace
 from functools import cached_property, partial
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # mpi4py and the scene reader are imported where used (start-up time)
+    from mpi4py import MPI
+
+    from .analyses.result import Result
+    from .scene import Scene, Sweep
 
 DEFAULT_SCENE = "bend45.toml"
 
@@ -23,7 +30,7 @@ class RunResult:
     and the run around it. ``to_json()`` is ``results.json``; ``run["key"]`` reads it."""
 
     scene: str
-    result: object  # the analysis's Result
+    result: "Result"  # the analysis's Result
     model: dict  # beams, degree, unknowns, kinematics, trimming, condensed
     probes: dict  # {probe name: values at the final state}
     wall_time_s: dict  # the analysis's split, and "run": the whole run in-process
@@ -32,10 +39,12 @@ class RunResult:
     pictures: dict | None = None  # the pictures rendered, if asked
 
     @property
-    def converged(self):
+    def converged(self) -> bool:
+        """Whether the analysis converged (its result's status)."""
         return self.result.status == "converged"
 
-    def to_json(self):
+    def to_json(self) -> dict:
+        """The content of results.json: scene, result, model, probes, wall time and outputs."""
         out = {"scene": self.scene, **self.result.to_json(), "model": self.model}
         if self.accuracy is not None:
             out["accuracy"] = self.accuracy
@@ -45,16 +54,18 @@ class RunResult:
         return out
 
     @cached_property
-    def json(self):
+    def json(self) -> dict:
+        """The results.json content, computed once."""
         return self.to_json()
 
-    def __getitem__(self, key):
+    def __getitem__(self, key: str) -> object:
         return self.json[key]
 
-    def get(self, key, default=None):
+    def get(self, key: str, default: object = None) -> object:
+        """Value of results.json key ``key``, or ``default``."""
         return self.json.get(key, default)
 
-    def __contains__(self, key):
+    def __contains__(self, key: object) -> bool:
         return key in self.json
 
 
@@ -65,8 +76,8 @@ def run_scene(
     restart: bool = False,
     png: bool = False,
     animate: bool = False,
-    comm=None,
-    scene=None,
+    comm: "MPI.Comm | None" = None,
+    scene: "Scene | None" = None,
 ) -> "RunResult | dict":
     """Solve the scene at ``path`` (built-in default if None) on ``comm`` (default: all
     ranks) and return its :class:`RunResult`; a ``[[sweep]]`` file returns the sweep's table
@@ -250,7 +261,7 @@ def _finish(run, out, scene, refinement, log, comm, png, animate):
     return run
 
 
-def check_scene(path: str | os.PathLike):
+def check_scene(path: str | os.PathLike) -> "Scene | Sweep":
     """Validate a scene without solving: keys, types, points, supports; for a sweep file every
     member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
     from .analyses.checks import check_supports_for

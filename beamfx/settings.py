@@ -48,10 +48,12 @@ def option(
         doc: what the key means, with its unit (goes into the docs' table).
         choices: the allowed values (strings or numbers).
         positive: the value (each value of a list) must be > 0.
-        low, high: inclusive bounds of the value.
+        low: inclusive lower bound of the value.
+        high: inclusive upper bound of the value.
         parse: for a value no annotation describes (e.g. ``[component, value]``): a function
             ``(value, fail) -> value`` that converts it or calls ``fail(message)``; the
             annotation is then ``object`` and ``word`` says in words what is allowed.
+        word: what a ``parse``d value may be, in words (for errors and the docs' table).
     """
     meta = {"doc": doc, "choices": choices, "positive": positive, "low": low, "high": high}
     meta.update(parse=parse, word=word)

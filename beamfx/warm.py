@@ -77,11 +77,15 @@ _CASES = {
 
 
 class Source(NamedTuple):
+    """A scene file to warm the JIT cache with."""
+
     name: str  # what the log calls it
     path: Path  # a scene file
 
 
 class Warmed(NamedTuple):
+    """What warming one scene compiled, and how long it took."""
+
     name: str
     compiled: int  # new kernels written to the cache (rank 0's count)
     seconds: float

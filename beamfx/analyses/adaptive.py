@@ -36,6 +36,8 @@ QUANTITIES = (
 
 
 class Trial(NamedTuple):
+    """One solve of the refinement: its mesh, value, change from the previous trial and cost."""
+
     elements: int  # per beam, before scaling by length
     degree: int
     unknowns: int
@@ -47,6 +49,8 @@ class Trial(NamedTuple):
 
 
 class Refinement(NamedTuple):
+    """The outcome of :func:`refine_to_tolerance`: the finest scene solved and all its trials."""
+
     scene: object  # the scene with the chosen elements and degree (the finest model solved)
     trials: tuple
     reached: bool

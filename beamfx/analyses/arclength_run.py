@@ -1,10 +1,13 @@
 """Arc-length continuation of a scene (``[analysis] type = "arclength"``): the equilibrium path
 through limit points, written to ``path.csv`` as it goes, its limit points in the results."""
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from ..settings import option
-from ..spec import DOF_NAMES
+from ..spec import DOF_NAMES, Model
+from .context import RunContext
+from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
@@ -38,11 +41,11 @@ class Settings:
         doc="stop when the control point's displacement component passes the value",
     )
 
-    def points(self):
+    def points(self) -> tuple[str, ...]:
         """Named points the model must have beyond the scene's probes."""
         return () if self.control_point is None else (self.control_point,)
 
-    def problems_in(self, model):
+    def problems_in(self, model: Model) -> Iterator[tuple[str, str]]:
         """The control point must be a point of the model."""
         from ..spec import resolve_point
 
@@ -52,7 +55,8 @@ class Settings:
             except ValueError as e:
                 yield "control_point", str(e)
 
-    def problems(self):
+    def problems(self) -> Iterator[tuple[str, str]]:
+        """(key, message) of contradictions between the keys: the trace needs a way to stop."""
         if self.target_load_factor is None and self.displacement_limit is None:
             yield "type", "arclength needs target_load_factor or displacement_limit to stop"
 
@@ -66,7 +70,8 @@ class Result(_Base):
     limit_points: tuple = entry("maxima and minima of the load factor along the path")
     stopped_by: str = entry("target, stop (displacement limit) or max_steps")
 
-    def summary(self):
+    def summary(self) -> dict:
+        """The numbers of a sweep table: the limit points and why the trace stopped."""
         return {"limit_points": list(self.limit_points), "stopped_by": self.stopped_by}
 
 
@@ -86,7 +91,7 @@ def _csv_writer(ctx):
     return record
 
 
-def run(model, settings, ctx):
+def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Trace the path from the unloaded state; probes and a frame at every accepted point."""
     from ..solvers.arclength import ArcLengthSettings
     from .continuation import limit_points, trace_path

@@ -39,6 +39,8 @@ from .modal import to_functions
 
 
 class BucklingResult(NamedTuple):
+    """Critical load factors, their modes and the pre-stress path of a buckling analysis."""
+
     load_factors: np.ndarray  # critical load factors λ* + μ, lowest positive μ first
     increments: np.ndarray  # μ: load factor beyond the state analysed
     modes: tuple  # dolfinx Functions on model.W
@@ -181,7 +183,7 @@ def geometric_stiffness(model, J_form, P_form, dw, eps=1e-4):
 
 
 def _scaled_max(model, f):
-    """max over the dofs of |u| / size and |rotation components|. Collective."""
+    """The largest of |u| / model size and |rotation components| over the dofs. Collective."""
     from mpi4py import MPI
 
     x = model.mesh.mesh.geometry.x

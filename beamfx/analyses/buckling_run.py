@@ -4,6 +4,8 @@ the undeformed state or about the current (loaded) one; one frame per mode."""
 from dataclasses import dataclass
 
 from ..settings import option
+from .context import RunContext
+from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
@@ -31,11 +33,12 @@ class Result(_Base):
     mode_shapes: tuple = entry("each mode's displacement at the probes (largest nodal = 1)")
     paraview_steps: str = entry("what the ParaView frames hold")
 
-    def summary(self):
+    def summary(self) -> dict:
+        """The numbers of a sweep table: the critical load factors."""
         return {"load_factors": list(self.load_factors)}
 
 
-def run(model, settings, ctx):
+def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """The buckling eigenproblem (K + λ K_G) φ = 0 about the chosen state."""
     from .buckling import solve_buckling
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes

@@ -22,6 +22,8 @@ GROWTH_TOL = 1e-6
 
 
 class CampbellResult(NamedTuple):
+    """A Campbell diagram: frequencies, branches and stability against the spin speed."""
+
     speeds: np.ndarray  # rad/s, the speeds reached (a failed steady state ends the sweep)
     frequencies_hz: np.ndarray  # (speeds, modes): per speed, lowest first
     branches_hz: np.ndarray  # (speeds, modes): branch b followed by shape from speed 0

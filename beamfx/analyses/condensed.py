@@ -91,6 +91,7 @@ class FollowerCoupling:
             F.value[:] = np_exp_rotation(self._g_at(dofs)) @ f0
 
     def reset(self):
+        """Put the reference forces f0 back into the constants (the undeformed state)."""
         for F, f0, _, _ in self.forces:
             F.value[:] = f0
 
@@ -126,6 +127,7 @@ class FollowerCoupling:
         return out / (2 * h)
 
     def destroy(self):
+        """Free the PETSc vectors of the G_i forms."""
         for G in self.G:
             for v in G:
                 v.destroy()
@@ -229,12 +231,14 @@ class CondensedModel(Discretised):
     # --- state ------------------------------------------------------------------------------
 
     def reset(self):
+        """Back to the undeformed state: zero rotations and displacements, reference forces."""
         self.w.x.array[:] = 0.0
         self.u.x.array[:] = 0.0
         if self.coupling:
             self.coupling.reset()
 
     def set_load_factor(self, lam):
+        """Set the load factor λ that scales every load."""
         self.load_factor.value = lam
 
     def unknowns(self):

@@ -18,6 +18,8 @@ from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
 
 
 class PathPoint(NamedTuple):
+    """A point of the traced path: load factor, control-point displacement, arc length."""
+
     load_factor: float
     displacement: np.ndarray  # (3,) at the control point, global axes
     iterations: int  # corrector iterations of the step that reached it (0 at the start)
@@ -25,6 +27,8 @@ class PathPoint(NamedTuple):
 
 
 class LimitPoint(NamedTuple):
+    """A maximum or minimum of the load factor along the path."""
+
     kind: str  # "maximum" or "minimum" of the load factor along the path
     load_factor: float
     displacement: np.ndarray  # (3,) at the control point
@@ -32,6 +36,8 @@ class LimitPoint(NamedTuple):
 
 
 class ContinuationResult(NamedTuple):
+    """The traced path, why the trace ended and the solver's steps and times."""
+
     path: tuple  # PathPoint, the first one the starting state
     control_point: str
     steps: tuple  # ArcLengthStep records of the solver
@@ -40,10 +46,12 @@ class ContinuationResult(NamedTuple):
 
     @property
     def load_factors(self):
+        """Load factor of each path point, the start first."""
         return np.array([p.load_factor for p in self.path])
 
     @property
     def displacements(self):
+        """(points, 3) displacements of the control point along the path (global axes)."""
         return np.array([p.displacement for p in self.path]).reshape(-1, 3)
 
 
@@ -91,7 +99,8 @@ def trace_path(
             step; True ends the trace (e.g. once the load has dropped past a limit point).
         settings: :class:`~beamfx.solvers.arclength.ArcLengthSettings` (follower loads are
             detected from the model).
-        options, prefix: PETSc options of the linear solver and their mandatory prefix.
+        options: PETSc options of the linear solver (without the prefix).
+        prefix: mandatory PETSc options prefix of the linear solver.
         on_step: called with each new :class:`PathPoint`.
         log: callable for one-line progress messages.
 

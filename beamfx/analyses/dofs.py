@@ -77,8 +77,8 @@ def point_displacement_dofs(model, at):
 
 
 def point_displacement(model, dofs, values=None):
-    """u at a point from :func:`point_displacement_dofs` (collective), of ``model.w`` or of
-    another array of the same space (``values``)."""
+    """Displacement u at a point from :func:`point_displacement_dofs` (collective), of
+    ``model.w`` or of another array of the same space (``values``)."""
     values = model.w.x.array if values is None else values
     local = np.array([values[d].sum() for d in dofs])
     count = np.array([len(d) for d in dofs], float)

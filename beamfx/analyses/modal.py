@@ -18,6 +18,8 @@ from ..solvers.forms import compile_form
 
 
 class ModalResult(NamedTuple):
+    """Eigenvalues ω², frequencies (rad/s, Hz) and modes of a modal analysis."""
+
     eigenvalues: np.ndarray  # ω² (1/s²), nearest to the target first
     omega: np.ndarray  # rad/s; sign(ω²)·sqrt|ω²|, so a (numerically) negative ω² stays visible
     hz: np.ndarray
@@ -82,6 +84,7 @@ def _mpi_min():
 
 
 def to_functions(model, vectors):
+    """The eigenvectors (PETSc Vec, destroyed here) as Functions ``mode_i`` on ``model.W``."""
     from dolfinx import fem
 
     modes = []

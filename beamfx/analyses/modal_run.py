@@ -6,6 +6,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..settings import option
+from .context import RunContext
+from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
@@ -45,11 +47,12 @@ class Result(_Base):
     mode_shapes: tuple = entry("each mode's displacement at the probes (largest nodal = 1)")
     paraview_steps: str = entry("what the ParaView frames hold")
 
-    def summary(self):
+    def summary(self) -> dict:
+        """The numbers of a sweep table: the frequencies (Hz)."""
         return {"frequencies_hz": list(self.frequencies_hz)}
 
 
-def run(model, settings, ctx):
+def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Pre-stress (if loaded and asked), then the modes nearest ``target_hz``."""
     from .modal import effective_masses, solve_modes
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes

@@ -3,11 +3,12 @@ failure (``status`` and ``reason``), extended by each analysis with its own fiel
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 
-def plain(obj):
+def plain(obj: object) -> object:
     """``obj`` as JSON-ready lists, dicts and numbers (NumPy, NamedTuples, dataclasses)."""
     if isinstance(obj, np.ndarray):
         return obj.tolist()
@@ -49,7 +50,7 @@ class Result:
     newton_iterations: int = 0
     seconds: dict = field(default_factory=dict)
 
-    def to_json(self):
+    def to_json(self) -> dict:
         """The analysis's entries of ``results.json`` (plain lists and numbers)."""
         out = {"analysis": self.analysis, "converged": self.status == "converged"}
         out["status"] = self.status
@@ -72,12 +73,12 @@ class Result:
                 out[f.name] = plain(getattr(self, f.name))
         return out
 
-    def summary(self):
+    def summary(self) -> dict:
         """The numbers of a sweep table (beyond probes and unknowns): by default none."""
         return {}
 
 
-def entry(doc=""):
+def entry(doc: str = "") -> Any:
     """A result field (documentation only; every field goes into ``results.json``)."""
     return field(metadata={"doc": doc})
 

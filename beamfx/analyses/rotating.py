@@ -181,6 +181,8 @@ def solve_steady(frame, speed, steps=10, options=None, prefix="beamfx_rotating_s
 
 
 class RotatingModes(NamedTuple):
+    """Complex modes about a steady rotating state: eigenvalues, frequencies (rad/s, Hz), growth."""
+
     eigenvalues: np.ndarray  # λ (1/s) with Im λ ≥ 0, lowest |Im λ| first
     omega: np.ndarray  # rad/s, |Im λ|: the frequency seen in the rotating frame
     hz: np.ndarray

@@ -2,11 +2,15 @@
 rotating-frame frequencies at each speed, the Campbell diagram as ``campbell.csv`` and
 ``campbell.png``, one frame per speed (the steady state)."""
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..settings import Vec3, option
+from ..spec import Model
+from .context import RunContext
+from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
@@ -24,7 +28,8 @@ class Settings:
     speed_rad_s: float | None = option(None, doc="one spin speed (rad/s) instead of a list")
     steps: int = option(10, positive=True, doc="load steps of the first steady state")
 
-    def problems(self):
+    def problems(self) -> Iterator[tuple[str, str]]:
+        """(key, message) of contradictions: a zero axis, no hub, both or neither speed key."""
         if not any(self.axis):
             yield "axis", "must not be zero"
         if self.hub is None:
@@ -33,11 +38,11 @@ class Settings:
             yield "speeds_rad_s", "give either speeds_rad_s = [...] or speed_rad_s = a number"
 
     @staticmethod
-    def defaults(model):
+    def defaults(model: Model) -> dict:
         """The hub defaults to the first support's point."""
         return {"hub": model.supports[0].at} if model.supports else {}
 
-    def problems_in(self, model):
+    def problems_in(self, model: Model) -> Iterator[tuple[str, str]]:
         """The hub must be a point of the model."""
         from ..spec import resolve_point
 
@@ -47,7 +52,7 @@ class Settings:
             yield "hub", str(e)
 
     @property
-    def speeds(self):
+    def speeds(self) -> tuple[float, ...]:
         """The speeds to solve (rad/s)."""
         return self.speeds_rad_s if self.speeds_rad_s is not None else (self.speed_rad_s,)
 
@@ -67,7 +72,8 @@ class Result(_Base):
     files: dict = entry("campbell.csv and campbell.png")
     steady_newton_iterations: tuple = entry("Newton iterations of each steady state")
 
-    def summary(self):
+    def summary(self) -> dict:
+        """The numbers of a sweep table: the frequencies (Hz) and why the sweep stopped."""
         return {"frequencies_hz": list(self.frequencies_hz), "stopped_by": self.stopped_by}
 
 
@@ -84,7 +90,7 @@ def _branches(result):
     )
 
 
-def run(model, settings, ctx):
+def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Steady state and frequencies at every speed; the Campbell files in the output folder."""
     from ..spec import resolve_point
     from .campbell import campbell, write_campbell

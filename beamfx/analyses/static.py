@@ -10,6 +10,8 @@ from ..solvers.stepping import SavedState
 
 
 class StaticResult(NamedTuple):
+    """The accepted load steps, Newton iterations and wall times of a static solve."""
+
     steps: tuple  # accepted LoadStep records
     newton_iterations: int
     seconds: dict  # wall time of this call: compile, assemble_F, assemble_J, solve (factorise,

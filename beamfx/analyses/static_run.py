@@ -3,11 +3,17 @@ and ``linear_static`` (linear kinematics, one solve). A frame and the probes aft
 accepted load step."""
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..settings import option
+from .context import RunContext
+from .formulation import Formulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
+
+if TYPE_CHECKING:  # heavy (PETSc): imported where used
+    from .static import StaticResult
 
 
 @dataclass(frozen=True)
@@ -25,7 +31,7 @@ class Result(_Base):
     path: tuple = entry("load factor and the probes' values after every accepted load step")
 
 
-def solve(model, settings, ctx):
+def solve(model: Formulation, settings: Settings, ctx: RunContext) -> tuple["StaticResult", tuple]:
     """Load stepping on ``model`` with the probes and frames of ``ctx`` after every step."""
     from .static import solve_static
 
@@ -43,7 +49,7 @@ def solve(model, settings, ctx):
     return solved, tuple(path)
 
 
-def run(model, settings, ctx):
+def run(model: Formulation, settings: Settings, ctx: RunContext) -> Result:
     """Solve to load factor 1; a condensed model that fails is replaced by the full one."""
     from ..solvers import SolveFailed
     from .condensed import RotationRangeError

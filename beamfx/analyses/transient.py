@@ -58,6 +58,7 @@ class TransientSettings:
     checkpoint_every: int = 50  # steps between checkpoints (0: never)
 
     def parameters(self):
+        """The :class:`~beamfx.solvers.integrators.AlphaParameters` of ``scheme``."""
         if self.scheme == "hht":
             return hht(self.hht_alpha)
         if self.scheme == "newmark":
@@ -68,6 +69,8 @@ class TransientSettings:
 
 
 class StepRecord(NamedTuple):
+    """An accepted time step: its size, Newton iterations, cut-backs and energies."""
+
     step: int
     time: float
     dt: float
@@ -78,6 +81,8 @@ class StepRecord(NamedTuple):
 
 
 class TransientResult(NamedTuple):
+    """The accepted time steps of a transient run and why it ended."""
+
     steps: tuple  # StepRecord of accepted steps (all of them)
     newton_iterations: int
     seconds: dict
@@ -244,9 +249,11 @@ class Dynamics:
         return np.sqrt(total / comm.allreduce(n))
 
     def state(self):
+        """Copies of the time-stepping state (q, v, a, q̈ at t_n), for a checkpoint."""
         return {k: getattr(self, k).x.array.copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
 
     def set_state(self, arrays):
+        """Restore the time-stepping state saved by :meth:`state`; the model's unknowns follow q."""
         for k, a in arrays.items():
             getattr(self, k).x.array[:] = a
         self.model.w.x.array[:] = self.q_n.x.array
@@ -344,9 +351,11 @@ class EnergyBalance:
         return out
 
     def get(self):
+        """The energy accounts, for a checkpoint."""
         return {"values": dict(self.values), "initial": self.initial, "previous": self.previous}
 
     def set(self, saved):
+        """Restore the energy accounts saved by :meth:`get`."""
         self.values, self.initial, self.previous = (
             dict(saved["values"]),
             saved["initial"],

@@ -8,13 +8,19 @@ energy balance); frames every ``output_every`` steps (or as ``[output]`` says); 
 
 import json
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..settings import option
+from .context import RunContext
+from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
+
+if TYPE_CHECKING:  # heavy (UFL, PETSc): imported where used
+    from .transient import TransientSettings
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
 ENERGY_KEYS = (
@@ -63,13 +69,13 @@ class Settings:
         return self.start == "rest"
 
     @property
-    def frames_every(self):
+    def frames_every(self) -> int:
         """Frames every this many steps, unless ``[output]`` says otherwise."""
         from ..io.output import default_every
 
         return self.output_every or default_every("transient", self.t_end / self.dt)
 
-    def solver(self):
+    def solver(self) -> "TransientSettings":
         """The integrator's :class:`~beamfx.analyses.transient.TransientSettings`."""
         from .transient import TransientSettings
 
@@ -101,7 +107,8 @@ class Result(_Base):
     probe_history: dict = entry("the files of the probe history")
     stopped_by: str = entry('"t_end" (a failed step raises, with its report)')
 
-    def summary(self):
+    def summary(self) -> dict:
+        """The numbers of a sweep table: why the run ended and the number of time steps."""
         return {"stopped_by": self.stopped_by, "time_steps": self.time_steps}
 
 
@@ -194,10 +201,12 @@ class History:
         self.files[1].write(json.dumps(entry) + "\n")
 
     def flush(self):
+        """Flush the probe files (rank 0)."""
         for f in self.files or ():
             f.flush()
 
     def close(self):
+        """Close the probe files (rank 0)."""
         for f in self.files or ():
             f.close()
         self.files = None
@@ -237,7 +246,7 @@ def _progress(comm, t_end):
     return bar, progress
 
 
-def run(model, settings, ctx):
+def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """March to ``t_end`` (or on from the last checkpoint), writing the history as it goes."""
     from .transient import solve_transient
 

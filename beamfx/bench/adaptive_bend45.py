@@ -42,6 +42,7 @@ class AdaptiveCase(Case):
     """Settings are (start elements, start degree, tolerance)."""
 
     def run_setting(self, elements, degree, tolerance):
+        """One row of the table: the adaptive refinement from the setting, its value and costs."""
         from mpi4py import MPI
 
         from ..analyses import static_run

@@ -389,6 +389,7 @@ def locking_summary(out):
 
 
 def main(argv=None):
+    """Command line: run the chosen cases (default all) and write the report (``--report DIR``)."""
     from mpi4py import MPI
 
     argv = list(sys.argv[1:] if argv is None else argv)

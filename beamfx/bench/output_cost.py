@@ -195,6 +195,7 @@ def _row(label, t):
 
 
 def report(frames, xdmf, runs):
+    """The markdown report: cost per frame as the frames add up, and the whole runs."""
     lines = ["# Output cost (`python -m beamfx.bench.output_cost`)", ""]
     lines += ["## Per frame, as the frames add up (ms, median / mean of the window)", ""]
     lines += ["| frames | vtu + surface, real transient | xdmf, repeated frames |", "|---|---|---|"]
@@ -212,6 +213,7 @@ def report(frames, xdmf, runs):
 
 
 def main(argv=None):
+    """Command line: measure the output cost and write the markdown report."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("report", help="markdown file to write")
     p.add_argument("--frames", type=int, default=10000, help="time steps of the transient")

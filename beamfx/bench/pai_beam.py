@@ -88,13 +88,16 @@ class Sweep:
 
     @property
     def t_end(self):
+        """Time at the end of the sweep (s): the ramp plus the sweep."""
         return self.ramp + self.duration
 
     @property
     def rate(self):
+        """Sweep rate df/dt (Hz/s)."""
         return (self.f_end - self.f_start) / self.duration
 
     def frequency(self, t):
+        """Instantaneous forcing frequency f(t) (Hz): ``f_start`` during the ramp, then linear."""
         s = np.clip(np.asarray(t, float) - self.ramp, 0.0, self.duration)
         return self.f_start + self.rate * s
 
@@ -116,6 +119,8 @@ class Sweep:
 
 
 class Trace(NamedTuple):
+    """The tip response of a transient run, with its cost."""
+
     t: np.ndarray
     tip: np.ndarray  # tip displacement along x relative to the clamp (m)
     steps: int
@@ -171,6 +176,7 @@ def _march(model, settings, saved=None, coordinate=None):
 
 
 def transient_settings(t_end, dt, damping=DAMPING, rho_inf=0.9):
+    """Transient settings of the sweeps and decays (stiffness-proportional ``damping``)."""
     from ..analyses.transient import TransientSettings
 
     return TransientSettings(
@@ -189,6 +195,8 @@ def run_sweep(sweep, dt=0.0025, elements=5, degree=3, damping=DAMPING):
 
 
 class Envelope(NamedTuple):
+    """Response amplitude (m) against forcing frequency (Hz), one point per forcing cycle."""
+
     frequency: np.ndarray  # forcing frequency at the middle of each forcing cycle (Hz)
     amplitude: np.ndarray  # half the peak-to-peak tip displacement in that cycle (m)
 
@@ -217,6 +225,8 @@ def peak(env):
 
 
 class Modes(NamedTuple):
+    """Linear modes about the gravity-loaded state and the modal coordinate of mode 2."""
+
     hz: np.ndarray
     second: np.ndarray  # mode-2 vector (unknowns' layout), scaled to unit tip displacement
     static: np.ndarray  # the gravity-loaded state
@@ -288,6 +298,8 @@ def run_free_decay(tip_velocity, t_end, dt=0.0025, elements=5, degree=3, damping
 
 
 class Backbone(NamedTuple):
+    """Amplitude (m) against frequency (Hz) of a free decay: the backbone curve."""
+
     amplitude: np.ndarray  # half the peak-to-peak tip displacement over one period (m)
     frequency: np.ndarray  # 1 / period between successive upward zero crossings (Hz)
 
@@ -299,7 +311,7 @@ def upward_crossings(t, x):
 
 
 def high_pass(t, x, cutoff):
-    """x without its content below ``cutoff`` Hz (4th-order Butterworth, run forwards and
+    """Signal x without its content below ``cutoff`` Hz (4th-order Butterworth, run forwards and
     backwards: no phase shift); t uniformly spaced."""
     from scipy.signal import butter, sosfiltfilt
 
@@ -373,6 +385,7 @@ class DecayCase(Case):
     """Settings are (elements, degree, dt); each runs two free decays (cold, then warm)."""
 
     def run_setting(self, elements, degree, dt):
+        """One row of the table: the decay's values, unknowns and cold and warm wall times."""
         from ..solvers.forms import compile_seconds
 
         c0, t0 = compile_seconds[0], time.perf_counter()

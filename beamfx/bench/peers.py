@@ -254,6 +254,7 @@ def _fmt(x, f="{:.2e}"):
 
 
 def plot(records, problem, title, path, target=None):
+    """Error against wall time of every code on ``problem`` (log-log), saved to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -352,6 +353,7 @@ def markdown(records, problems, notes=None):
 
 
 def load_peer_records(peer_dir):
+    """The records of every peer code's JSON file in ``peer_dir``."""
     records = []
     for f in sorted(Path(peer_dir).glob("*.json")):
         if f.name in ("problems.json", "beamfx.json"):
@@ -373,8 +375,9 @@ def load_peer_notes(peer_dir):
 
 
 def merge(peer_dir, report_dir, run=True, log=print):
-    """beamfx records (run now, or read from ``peer_dir/beamfx.json``) + peer records ->
-    ``report_dir/peers.md``, ``peers.json`` and one ``peers_<problem>.png`` per problem."""
+    """Write the peer report: beamfx records (run now, or read from ``peer_dir/beamfx.json``)
+    + peer records -> ``report_dir/peers.md``, ``peers.json`` and one ``peers_<problem>.png``
+    per problem."""
     peer_dir, report = Path(peer_dir), Path(report_dir)
     problems = json.loads((peer_dir / "problems.json").read_text())
     if run or not (peer_dir / "beamfx.json").exists():
@@ -403,6 +406,7 @@ def merge(peer_dir, report_dir, run=True, log=print):
 
 
 def main(argv=None):
+    """Command line: ``export DIR``, ``beamfx DIR`` or ``DIR REPORT_DIR [--no-run]``."""
     argv = list(sys.argv[1:] if argv is None else argv)
     usage = (
         "usage: python -m beamfx.bench.peers export DIR | beamfx DIR | DIR REPORT_DIR [--no-run]"

@@ -39,7 +39,10 @@ def _solve(spec, steps):
 
 @dataclass(frozen=True)
 class PlanarCase(Case):
+    """The roll-up solved with the planar and the full 3D model at each setting."""
+
     def run_setting(self, elements, degree):
+        """One row of the table: the planar model's values and costs beside the full model's."""
         spec, steps = self.build(elements, degree)
         planar = replace(spec, kinematics=Kinematics(plane="xz"))
         xp, n_p, its, cold, warm = _solve(planar, steps)

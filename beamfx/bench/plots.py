@@ -152,6 +152,7 @@ def history_panel(ax, r):
 
 
 def plt_colours():
+    """Matplotlib's ten default colours, in cycle order."""
     return [f"C{i}" for i in range(10)]
 
 

@@ -21,6 +21,7 @@ def process_seconds(case_id, elements, degree, folder):
 
 
 def main(argv):
+    """Child process: run one setting of a case through :func:`~beamfx.runner.run_scene`."""
     case_id, elements, degree, folder = argv
     from ..runner import run_scene
     from . import all_cases

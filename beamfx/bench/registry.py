@@ -53,6 +53,7 @@ REGISTRY: dict[str, Case] = {}
 
 
 def register(case):
+    """Add ``case`` to :data:`REGISTRY` (its id must be new); return it."""
     if case.id in REGISTRY:
         raise ValueError(f"duplicate benchmark case {case.id}")
     REGISTRY[case.id] = case

@@ -102,6 +102,7 @@ def criterion_1mm(rows):
 
 
 def run_case(case, log=print):
+    """Run every setting of ``case`` and score it against the reference: one result dict."""
     rows = []
     for setting in case.settings:  # (elements, degree) or, for transients, (…, dt)
         n, p = setting[:2]
@@ -316,6 +317,7 @@ def markdown(results, figures=None, note=None):
 
 
 def run_bench(ids=None, report=None, log=print):
+    """Run the cases ``ids`` (default all); with ``report``, write bench.json, plots, README.md."""
     from . import all_cases
 
     cases = all_cases()

@@ -40,6 +40,7 @@ class EigenCase(Case):
     ``(values, unknowns, newton_iterations)``; run by :meth:`run_setting` (cold, then warm)."""
 
     def run_setting(self, elements, degree):
+        """One row of the table: the eigenvalues, unknowns and cold and warm wall times."""
         from ..solvers.forms import compile_seconds
 
         c0, t0 = compile_seconds[0], time.perf_counter()

@@ -199,6 +199,7 @@ CASES = {"sm21": sm21, "sm22": sm22, "bend45": bend45, "sm28": sm28}
 
 
 def main(argv=None):
+    """Command line: run the chosen cases (default all) and write the report (``--report DIR``)."""
     from mpi4py import MPI
 
     argv = list(sys.argv[1:] if argv is None else argv)

@@ -217,6 +217,7 @@ def report(folder):
 
 
 def main(argv=None):
+    """Command line: ``run DIR`` measures the scaling, ``report DIR`` writes its report."""
     from mpi4py import MPI
 
     argv = list(sys.argv[1:] if argv is None else argv)

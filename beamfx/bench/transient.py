@@ -79,6 +79,7 @@ class TransientCase(Case):
     series: object = None
 
     def run_setting(self, elements, degree, dt):
+        """One row of the table: the measured values, unknowns and cold and warm wall times."""
         from ..solvers.forms import compile_seconds
         from .profiling import per_iteration
 
@@ -136,6 +137,9 @@ def spin_up_series(history):
 
 
 def spin_up_measure(history, model=None):
+    """Spin-up quantities from the (t, tip position, planar angle) history: least axial and
+    transverse tip displacement in the rotating frame, least relative rotation, mean stretch over
+    15–18 s."""
     t = np.array([h[0] for h in history])
     x = np.array([h[1] for h in history])
     psi = hub_angle(t)
@@ -207,6 +211,7 @@ BEND = reference("howcroft_2016.json", "bend45_vertical")
 
 
 def bend45_model(elements, degree):
+    """The 45° bend cantilever (Bathe & Bolourchi) with a constant tip load F_z."""
     from ..physics.sections import rectangle
 
     s = BEND["section"]
@@ -217,6 +222,7 @@ def bend45_model(elements, degree):
 
 
 def bend45_settings(dt):
+    """Transient settings of the damped 45° bend (60 s, heavy stiffness-proportional damping)."""
     from ..analyses.transient import TransientSettings
 
     # ω1 ≈ 0.5 rad/s (arc length 78.5, EI = 8.3e5, ρA = 1): a1 = 2/ω1 damps mode 1 critically
@@ -286,6 +292,7 @@ def flying_spaghetti_model(elements, degree):
 
 
 def flying_settings(dt):
+    """Transient settings of the flying spaghetti (40 s, energy-momentum conserving scheme)."""
     from ..analyses.transient import TransientSettings
 
     return TransientSettings(t_end=40.0, dt=dt, scheme="conserving", checkpoint_every=0)

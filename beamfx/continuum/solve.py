@@ -158,6 +158,7 @@ class ContinuumBeam:
         return forms.mass_form(d["rho"], d["h"], d["w"], split(v), split(dw)) * self.dx
 
     def unknowns(self):
+        """Global number of unknowns."""
         return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
 
     # --- results -----------------------------------------------------------------------------

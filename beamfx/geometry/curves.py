@@ -20,18 +20,23 @@ def _unit(v):
 
 @dataclass(frozen=True)
 class Line:
+    """Straight segment from ``start`` to ``end``."""
+
     start: tuple
     end: tuple
 
     @property
     def length(self):
+        """Arc length of the curve."""
         return float(np.linalg.norm(np.subtract(self.end, self.start)))
 
     @property
     def kinks(self):
+        """Arc lengths of the corners where the tangent jumps (none)."""
         return ()
 
     def points(self, s):
+        """(n, 3) points of the curve at the arc lengths ``s`` from the start."""
         d = np.subtract(self.end, self.start) / self.length
         return np.asarray(self.start, float) + np.outer(s, d)
 
@@ -50,17 +55,21 @@ class Arc:
 
     @property
     def radius(self):
+        """Radius of the arc (distance from the centre to ``start``)."""
         return float(np.linalg.norm(np.subtract(self.centre, self.start)))
 
     @property
     def length(self):
+        """Arc length of the curve."""
         return self.radius * np.deg2rad(self.angle_deg)
 
     @property
     def kinks(self):
+        """Arc lengths of the corners where the tangent jumps (none)."""
         return ()
 
     def points(self, s):
+        """(n, 3) points of the curve at the arc lengths ``s`` from the start."""
         c = np.asarray(self.centre, float)
         e_r = _unit(np.subtract(self.start, c))  # from centre to start
         t = np.asarray(self.start_tangent, float)
@@ -89,13 +98,16 @@ class Helix:
 
     @property
     def length(self):
+        """Arc length of the curve."""
         return self.turns * self._c
 
     @property
     def kinks(self):
+        """Arc lengths of the corners where the tangent jumps (none)."""
         return ()
 
     def points(self, s):
+        """(n, 3) points of the curve at the arc lengths ``s`` from the start."""
         a = _unit(self.axis)
         e1 = np.asarray(self.start_direction, float)
         e1 = _unit(e1 - (e1 @ a) * a)
@@ -121,13 +133,16 @@ class Polyline:
 
     @property
     def length(self):
+        """Arc length of the curve."""
         return float(self._cum[-1])
 
     @property
     def kinks(self):
+        """Arc lengths of the inner vertices, where the tangent jumps."""
         return tuple(self._cum[1:-1])
 
     def points(self, s):
+        """(n, 3) points of the curve at the arc lengths ``s`` from the start."""
         v = np.asarray(self.vertices, float)
         s = np.atleast_1d(np.asarray(s, float))
         return np.stack([np.interp(s, self._cum, v[:, i]) for i in range(3)], axis=1)
@@ -164,13 +179,16 @@ class SampledCurve:
 
     @property
     def length(self):
+        """Arc length of the curve."""
         return float(self._table[1].x[-1])
 
     @property
     def kinks(self):
+        """Arc lengths of the corners where the tangent jumps (none)."""
         return ()
 
     def points(self, s):
+        """(n, 3) points of the curve at the arc lengths ``s`` from the start."""
         spline, p_of_s = self._table
         return spline(p_of_s(np.atleast_1d(s)))
 

@@ -24,6 +24,8 @@ class BeamSpec:
 
 
 class BeamMesh(NamedTuple):
+    """The interval mesh of a model's beams with the cells' beams and spans and the named points."""
+
     mesh: object  # dolfinx.mesh.Mesh, P_k geometry
     degree: int
     specs: tuple

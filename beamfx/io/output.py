@@ -164,7 +164,7 @@ class FrameWriter:
         self.policy = FramePolicy(settings)
 
     def want(self, step, time, last=False):
-        """Is accepted step ``step`` at ``time`` a frame? (:class:`FramePolicy`)"""
+        """Whether accepted step ``step`` at ``time`` is a frame (:class:`FramePolicy`)."""
         return self.policy.want(step, time, last)
 
     def follow(self, model):

@@ -51,8 +51,10 @@ def section_outline(type, h=None, w=None, d=None, d_inner=0.0, segments=CIRCLE_S
 
     Args:
         type: "rectangle", "circle", "tube" or "general" (the scene's section types).
-        h, w: rectangle height along e3 and width along e2.
-        d, d_inner: outer and inner diameter of a circle or tube.
+        h: rectangle height along e3.
+        w: rectangle width along e2.
+        d: outer diameter of a circle or tube.
+        d_inner: inner diameter of a tube (0: a full circle).
         segments: points per circle.
     """
     if type == "rectangle":

@@ -70,7 +70,8 @@ def unstructured_grid(points, connectivity, offsets, types, point_data=None, cel
         connectivity: point indices of all cells, one after another.
         offsets: (cells + 1,) start of each cell in ``connectivity``, then its length.
         types: (cells,) VTK cell types.
-        point_data, cell_data: ``{name: array}`` with n (cells) rows.
+        point_data: ``{name: array}`` with n rows.
+        cell_data: ``{name: array}`` with one row per cell.
     """
     from vtkmodules.util.numpy_support import numpy_to_vtkIdTypeArray
     from vtkmodules.vtkCommonCore import vtkPoints

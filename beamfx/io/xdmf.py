@@ -86,6 +86,7 @@ class XdmfSeries:
         self.close()
 
     def close(self):
+        """Close the file (again: nothing)."""
         if self.file is not None:
             self.file.close()
             self.file = None

@@ -54,7 +54,7 @@ def section_strains(g, n, Lam0, compliance):
 
 
 def position_rate(g, n, t0, Lam0, compliance):
-    """x' = R (t0 + Λ0 Γ) with Γ from the section force ``n``."""
+    """Centre-line tangent x' = R (t0 + Λ0 Γ) with Γ from the section force ``n``."""
     R = rotation(rotation_quaternion(g))
     return R * (t0 + Lam0 * section_strains(g, n, Lam0, compliance))
 

@@ -36,7 +36,7 @@ def force_work(kin, rot, v_u, force, follower):
 
 
 def moment_work(kin, rot, v_rot, moment, kind, arm=None):
-    """Virtual work of a moment of ``kind``:
+    """Virtual work of a moment of ``kind``, one of the three below.
 
     * "dead": M·δθ, fixed in space (global axes). Not conservative for finite 3D rotations;
       its tangent is unsymmetric and the solvers use LU, which does not mind.

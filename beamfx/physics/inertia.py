@@ -44,8 +44,13 @@ def mass_form(kin, rot, v, dw, inertia, Lam0, dx, rotary="full"):
     """Mass bilinear form m(v, dw) about the configuration with rotation field ``rot``.
 
     Args:
-        v, dw: (displacement, rotation) pairs of the test and trial functions.
+        kin: the kinematics options of the model.
+        rot: rotation field of the configuration.
+        v: (displacement, rotation) pair of the test functions.
+        dw: (displacement, rotation) pair of the trial functions.
         inertia: (ρA, ρI_polar, ρI_y, ρI_z) per point, section axes.
+        Lam0: reference section frame Λ0 (columns: section axes in global axes).
+        dx: integration measure along the centre line.
         rotary: one of :data:`ROTARY`.
     """
     import ufl
@@ -109,8 +114,12 @@ def point_mass_form(kin, rot, v, dw, mass, inertia):
     m δu·Δu + δθ·(R J0 Rᵀ) Δθ with δθ = axial(δR Rᵀ) (the point form of :func:`mass_form`).
 
     Args:
-        v, dw: (displacement, rotation) pairs of the test and trial functions.
-        mass: m; inertia: J0 about the point (3x3, global axes in the reference state).
+        kin: the kinematics options of the model.
+        rot: rotation field of the current configuration.
+        v: (displacement, rotation) pair of the test functions.
+        dw: (displacement, rotation) pair of the trial functions.
+        mass: m.
+        inertia: J0 about the point (3x3, global axes in the reference state).
     """
     import ufl
 
@@ -127,9 +136,12 @@ def point_kinetic_energy(kin, rot, u_dot3, omega, mass, inertia):
     r"""Kinetic energy of a rigid body at a point: T = ½ m |u̇|² + ½ ω·(R J0 Rᵀ) ω.
 
     Args:
+        kin: the kinematics options of the model.
+        rot: rotation field of the current configuration.
         u_dot3: velocity of the point (3-vector, global axes).
         omega: spatial angular velocity ω = axial(Ṙ Rᵀ) (3-vector, global axes).
-        mass: m; inertia: J0 about the point (3x3, global axes in the reference state).
+        mass: m.
+        inertia: J0 about the point (3x3, global axes in the reference state).
     """
     import ufl
 

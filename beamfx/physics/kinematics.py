@@ -28,6 +28,7 @@ class Kinematics:
 
     @property
     def displacement_size(self):
+        """Displacement components at a node: 2 in a plane, else 3."""
         return 2 if self.plane else 3
 
     @property
@@ -51,6 +52,7 @@ PLANES = {"xy": (0, 1, 2), "yz": (1, 2, 0), "xz": (2, 0, 1)}
 
 
 def plane_normal(kin):
+    """Unit normal of the plane of a planar model (global axes)."""
     import ufl
 
     return ufl.as_vector([1.0 if i == PLANES[kin.plane][2] else 0.0 for i in range(3)])

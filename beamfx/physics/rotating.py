@@ -23,7 +23,7 @@ from .rotations import hat
 
 
 def relative_position(X, u, hub):
-    """r = X + u − H: current centre-line point relative to the hub (global axes)."""
+    """Position r = X + u − H: current centre-line point relative to the hub (global axes)."""
     return X + u - hub
 
 

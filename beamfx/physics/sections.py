@@ -33,10 +33,12 @@ class Section:
 
     @property
     def C_N(self):
+        """Force stiffnesses (EA, GA_y, GA_z), section axes."""
         return np.array([self.EA, self.GA_y, self.GA_z])
 
     @property
     def C_M(self):
+        """Moment stiffnesses (GJ, EI_y, EI_z), section axes."""
         return np.array([self.GJ, self.EI_y, self.EI_z])
 
     def stiffnesses(self):
@@ -148,6 +150,8 @@ class SectionAlong:
     varies = True
 
     def along(self, s):
+        """The :class:`Section` at each arc length of ``s``."""
+
         def value(v, si):
             return float(v(si)) if callable(v) else v
 

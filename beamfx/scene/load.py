@@ -4,6 +4,7 @@ The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, `
 ``EI_y``, ``angle_deg``, ``start_tangent``, ...). See docs/scenes.md for every key.
 """
 
+import os
 import tomllib
 from dataclasses import dataclass, field
 from functools import partial
@@ -62,12 +63,12 @@ class Scene:
             object.__setattr__(self, "settings", analysis(self.analysis).settings())
 
     @property
-    def output_dir(self):
+    def output_dir(self) -> str:
         """The output folder of ``[output] dir``."""
         return self.output.dir
 
     @property
-    def steps(self):
+    def steps(self) -> int:
         """Load steps of the analysis's static solves (10 where it has none)."""
         return getattr(self.settings, "steps", 10)
 
@@ -305,7 +306,7 @@ def _fix(t):
     return tuple(fix)
 
 
-def parse_scene(data, file="<scene>", base=Path(".")):
+def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Scene:
     """Scene from already-parsed TOML data (``file`` is used in error messages)."""
     top = Table(data, "", file)
     mat = _material(top.table("material", None))
@@ -636,7 +637,7 @@ def _check_orientation(beam, where):
         )
 
 
-def read_toml(path):
+def read_toml(path: str | os.PathLike) -> dict:
     """The TOML data of the file at ``path``; a missing or malformed file is a SceneError."""
     try:
         return tomllib.loads(Path(path).read_text())
@@ -646,7 +647,7 @@ def read_toml(path):
         raise SceneError(f"{path}: not valid TOML: {e}") from None
 
 
-def load_scene(path):
+def load_scene(path: str | os.PathLike) -> Scene:
     """Read and validate a scene file; raises :class:`SceneError` naming file and key."""
     path = Path(path)
     data = read_toml(path)

@@ -18,6 +18,7 @@ read, so a bad value is reported before anything is solved.
 
 import copy
 import itertools
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -102,7 +103,7 @@ def _axes(entries, file):
     return axes
 
 
-def parse_sweep(data, file="<scene>", base=Path(".")):
+def parse_sweep(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sweep:
     """The :class:`Sweep` of already-parsed TOML data with ``[[sweep]]`` tables."""
     data = dict(data)
     entries = data.pop("sweep")
@@ -125,13 +126,13 @@ def parse_sweep(data, file="<scene>", base=Path(".")):
     return Sweep(file, keys, tuple(members), out)
 
 
-def load_sweep(path):
+def load_sweep(path: str | os.PathLike) -> Sweep | None:
     """The :class:`Sweep` of the file at ``path``, or None if it has no ``[[sweep]]`` table."""
     loaded = load_scene_or_sweep(path)
     return loaded if isinstance(loaded, Sweep) else None
 
 
-def load_scene_or_sweep(path):
+def load_scene_or_sweep(path: str | os.PathLike) -> Scene | Sweep:
     """The file at ``path`` read once: a :class:`Sweep` if it has ``[[sweep]]`` tables, else
     its :class:`Scene`."""
     path = Path(path)

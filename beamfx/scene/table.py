@@ -26,12 +26,15 @@ class Table:
         self.data, self.path, self.file, self.used = data, path, file, set()
 
     def where(self, key):
+        """``file: path.key``, how errors name the key."""
         return f"{self.file}: {self.path + '.' if self.path else ''}{key}"
 
     def fail(self, key, message):
+        """Raise a :class:`SceneError` naming ``key`` and its file."""
         raise SceneError(f"{self.where(key)}: {message}")
 
     def has(self, key):
+        """Whether the table has ``key``."""
         return key in self.data
 
     def get(self, key, kind=float, default=..., choices=None, positive=False):
@@ -67,6 +70,7 @@ class Table:
         return value
 
     def table(self, key, default=...):
+        """Sub-table ``key`` as a :class:`Table` (None if it is missing and ``default`` is None)."""
         value = self.get(key, dict, default)
         return (
             None
@@ -80,6 +84,7 @@ class Table:
         return [Table(item, f"{key}[{i}]", self.file) for i, item in enumerate(items)]
 
     def done(self, allowed_note=""):
+        """Fail on the first key no getter asked for, listing the allowed keys."""
         unknown = sorted(set(self.data) - self.used)
         if unknown:
             self.fail(

@@ -127,6 +127,7 @@ def compare(beam, solid):
 
 
 def markdown(rows):
+    """Markdown table of the beam-against-solid rows of each probe's quantity."""
     lines = [
         "| probe | quantity | beam | solid | (solid − beam)/max|beam| |",
         "|---|---|---|---|---|",

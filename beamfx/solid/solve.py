@@ -81,6 +81,7 @@ class Solid:
             self.faces[name] = {"tag": tag, "A": A, "c": c, "I2": I2, "frame": frame}
 
     def unknowns(self):
+        """Global number of unknowns."""
         return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
 
     def energy(self, material=None):
@@ -115,6 +116,7 @@ class Solid:
         return norm
 
     def iterative(self):
+        """Whether to use the iterative solver (asked, or ``auto`` above :data:`DIRECT_LIMIT`)."""
         return self.spec.solver == "iterative" or (
             self.spec.solver == "auto" and self.unknowns() > DIRECT_LIMIT
         )
@@ -246,8 +248,8 @@ class Solid:
 
 
 def mode_kind(kind_forms, comm):
-    """ "axial" if most of ∫|u|² is along the axis, "torsion" if most is the twist about it,
-    else "bending"."""
+    """Mode kind: "axial" if most of ∫|u|² is along the axis, "torsion" if most is the twist
+    about it, else "bending"."""
     from dolfinx import fem
 
     axial, twist, total = (comm.allreduce(fem.assemble_scalar(f)) for f in kind_forms)

@@ -94,6 +94,8 @@ class ArcLengthSettings:
 
 
 class ArcLengthStep(NamedTuple):
+    """An accepted arc-length step: load factor, length, corrector iterations and cut-backs."""
+
     step: int
     load_factor: float
     arc_length: float  # length of the step, (Δw^T S Δw + ψ² Δλ² f^T f)^½ (= Δl for Crisfield)
@@ -103,6 +105,8 @@ class ArcLengthStep(NamedTuple):
 
 
 class ArcLengthResult(NamedTuple):
+    """The accepted steps of an arc-length trace, why it ended and its wall times."""
+
     steps: tuple  # accepted ArcLengthStep records
     reason: str  # "target", "stop", "max_steps"
     seconds: dict  # wall time split: assemble_F, assemble_J, solve, total
@@ -173,7 +177,7 @@ class ArcLengthSolver:
         return self.R.norm()
 
     def _load(self):
-        """f = F(w, 0) - F(w, 1) = -∂F/∂λ at the current w, zero on constrained dofs."""
+        """Load vector f = F(w, 0) - F(w, 1) = -∂F/∂λ at the current w, zero on constrained dofs."""
         t = time.perf_counter()
         assemble_load(self.f, self.F, self.lam, self.bcs)
         self.ff = self.f.dot(self.f)
@@ -197,7 +201,7 @@ class ArcLengthSolver:
             self.seconds["solve"] += time.perf_counter() - t
 
     def _solve(self, rhs, out, scale=1.0):
-        """out = scale · K⁻¹ rhs with the current factorisation."""
+        """Solve out = scale · K⁻¹ rhs with the current factorisation."""
         t = time.perf_counter()
         self.ksp.solve(rhs, out)
         if scale != 1.0:
@@ -216,7 +220,7 @@ class ArcLengthSolver:
         return self.comm.allreduce(float(local), op=MPI.SUM)
 
     def _add(self, vec, alpha=1.0):
-        """w += alpha · vec (owned dofs), then refresh the ghosts."""
+        """Update w += alpha · vec (owned dofs), then refresh the ghosts."""
         self.w.vector.axpy(alpha, vec)
         self.w.x.scatter_forward()
 
@@ -234,6 +238,8 @@ class ArcLengthSolver:
         """Corrector iterations of one step from the current (converged) state (w_n, λ_n).
 
         Args:
+            lam_n: load factor λ_n of the converged state.
+            dl: arc length Δl of the step (displacement units).
             direction: (Δw_prev, Δλ_prev) of the previous step, or the sign of the first one.
             land_at: solve at this fixed load factor instead (δλ = 0), from the predictor
                 ``direction = (Δw, Δλ)`` scaled onto it.
@@ -456,5 +462,6 @@ class ArcLengthSolver:
         )
 
     def destroy(self):
+        """Free the solver's PETSc objects."""
         for obj in (self.ksp, self.A, self.R, self.f, self.dw_R, self.dw_f):
             obj.destroy()

@@ -3,7 +3,7 @@ solvers: Newton, arc length, load scaling)."""
 
 
 def assemble_residual(b, F, J, bcs, x):
-    """b = F with lifting of ``bcs`` about ``x`` and b = x - g on constrained rows (b zeroed first).
+    """Residual b = F with lifting of ``bcs`` about ``x``, b = x - g on constrained rows (b zeroed).
 
     The Newton correction then drives the constrained dofs to their prescribed values g.
     """
@@ -28,7 +28,7 @@ def assemble_tangent(A, J, bcs):
 
 
 def assemble_load(f, F, load_factor, bcs):
-    """f = F(w, 0) - F(w, 1) = -∂F/∂λ at the current w, for F linear in the load factor
+    """Load vector f = F(w, 0) - F(w, 1) = -∂F/∂λ at the current w, for F linear in the load factor
     (a ``fem.Constant``), zero on constrained dofs; the load factor is left unchanged."""
     import dolfinx.fem.petsc as fp
     from petsc4py import PETSc

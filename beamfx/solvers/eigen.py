@@ -23,6 +23,8 @@ DEFAULT_OPTIONS = {
 
 
 class EigenPairs(NamedTuple):
+    """Converged eigenpairs with their residuals, iterations and wall time."""
+
     values: np.ndarray  # complex eigenvalues, nearest to the target first
     vectors: tuple  # real parts of the eigenvectors (PETSc Vec)
     residuals: np.ndarray  # ‖A x − λ B x‖ / (|λ| ‖x‖) per pair (SLEPc's relative error)
@@ -60,10 +62,14 @@ def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=N
     """The ``nev`` eigenpairs of A x = λ B x nearest to ``target``.
 
     Args:
-        A, B: assembled PETSc matrices (B may be singular: its null rows go to λ = ∞).
+        A: assembled PETSc matrix (stiffness side).
+        B: assembled PETSc matrix (may be singular: its null rows go to λ = ∞).
+        nev: number of eigenpairs wanted.
         target: where to look; the spectral transform shifts to ``shift`` (default: ``target``).
-        prefix: PETSc options prefix; ``options`` (without it) override :data:`DEFAULT_OPTIONS`.
+        prefix: PETSc options prefix.
+        options: PETSc options (without the prefix) that override :data:`DEFAULT_OPTIONS`.
         hermitian: GHEP (A, B symmetric, B semi-definite) or GNHEP.
+        shift: shift of the spectral transform; None: ``target``.
 
     Raises:
         RuntimeError: if fewer than ``nev`` pairs converged.

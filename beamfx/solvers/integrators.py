@@ -21,6 +21,8 @@ from typing import NamedTuple
 
 
 class AlphaParameters(NamedTuple):
+    """The parameters (α_m, α_f, β, γ) of a generalized-α family scheme, and its name."""
+
     alpha_m: float
     alpha_f: float
     beta: float

@@ -29,6 +29,8 @@ DEFAULT_OPTIONS = {
 
 
 class QuadraticPairs(NamedTuple):
+    """Converged pairs of the quadratic eigenproblem with residuals, iterations and wall time."""
+
     values: np.ndarray  # complex eigenvalues λ, nearest to the target first
     vectors: tuple  # (real part, imaginary part) of each eigenvector, NumPy arrays (local)
     residuals: np.ndarray  # SLEPc's backward error of each pair
@@ -45,7 +47,6 @@ def scale_estimate(K, M, nev, prefix):
     of 32 quartic elements); with any factor within two decades of the wanted |λ| they agree
     with the generalised problem to 1e-12.
     """
-
     pairs = solve_eigen(K, M, nev, 0.0, prefix + "scale_", hermitian=False)
     for x in pairs.vectors:
         x.destroy()
@@ -57,10 +58,14 @@ def solve_quadratic(K, G, M, nev, target, prefix, options=None, scale=None):
     """The ``nev`` eigenpairs of (λ² M + λ G + K) x = 0 nearest to the real ``target``.
 
     Args:
-        K, G, M: assembled PETSc matrices (M may be singular: its null directions go to λ = ∞).
+        K: assembled stiffness matrix.
+        G: assembled gyroscopic (or damping) matrix.
+        M: assembled mass matrix (may be singular: its null directions go to λ = ∞).
+        nev: number of eigenpairs wanted.
         target: where to look (real); shift-and-invert factorises λ² M + λ G + K there, so K
             must be regular for the default target 0.
-        prefix: PETSc options prefix; ``options`` (without it) override :data:`DEFAULT_OPTIONS`.
+        prefix: PETSc options prefix.
+        options: PETSc options (without the prefix) that override :data:`DEFAULT_OPTIONS`.
         scale: the factor λ is scaled by (``pep_scale_factor``); default :func:`scale_estimate`
             with ``nev`` // 2 pairs (eigenvalues of the undamped problem come as ±iω).
 

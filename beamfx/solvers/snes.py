@@ -44,6 +44,8 @@ def linear_solve_seconds():
 
 
 class SolveReport(NamedTuple):
+    """The outcome of a nonlinear solve: converged, why, the iterations and wall times."""
+
     converged: bool
     reason: str
     iterations: int
@@ -166,6 +168,7 @@ class NewtonSolver:
         )
 
     def destroy(self):
+        """Free the SNES and its matrix and vectors."""
         self.snes.destroy()
         self.A.destroy()
         self.b.destroy()

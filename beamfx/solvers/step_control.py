@@ -22,6 +22,8 @@ class StepTooSmall(Exception):
 
 @dataclass
 class EasyGrowth:
+    """Grow by ``factor`` after ``run`` easy steps in a row (see the module docstring)."""
+
     factor: float = 1.5
     easy: int = 4
     run: int = 1
@@ -29,6 +31,7 @@ class EasyGrowth:
     _streak: int = 0
 
     def ratio(self, iterations, cutbacks, error):
+        """Factor of the next step size after an accepted step."""
         self._streak = self._streak + 1 if iterations <= self.easy else 0
         grow = self._streak >= self.run and not (self.clean and cutbacks)
         return self.factor if grow else 1.0
@@ -36,16 +39,21 @@ class EasyGrowth:
 
 @dataclass
 class IterationRatio:
+    """Crisfield's ``sqrt(desired / iterations)`` within [``least``, ``most``]."""
+
     desired: int = 4
     least: float = 0.5
     most: float = 2.0
 
     def ratio(self, iterations, cutbacks, error):
+        """Factor of the next step size after an accepted step."""
         return min(self.most, max(self.least, math.sqrt(self.desired / max(iterations, 1))))
 
 
 @dataclass
 class ErrorBased:
+    """``safety · error^(−1/(order+1))`` within [``least``, ``most``] (error 1: the tolerance)."""
+
     order: int = 2
     safety: float = 0.9
     least: float = 0.2  # of a cut-back
@@ -55,9 +63,11 @@ class ErrorBased:
         return self.safety * error ** (-1.0 / (self.order + 1))
 
     def ratio(self, iterations, cutbacks, error):
+        """Factor of the next step size after an accepted step with the scaled ``error``."""
         return min(self.most, self._factor(max(error, 1e-10)))
 
     def shrink(self, error):
+        """Factor of a cut-back after a step rejected with the scaled ``error``."""
         return max(self.least, self._factor(error))
 
 

@@ -12,14 +12,18 @@ class SavedState:
         self.w, self.saved = w, w.x.array.copy()
 
     def save(self):
+        """Keep the current unknowns."""
         self.saved[:] = self.w.x.array
 
     def restore(self):
+        """Put the kept unknowns back (ghosts updated)."""
         self.w.x.array[:] = self.saved
         self.w.x.scatter_forward()
 
 
 class LoadStep(NamedTuple):
+    """An accepted load step: load factor, Newton iterations, residuals and cut-backs."""
+
     step: int
     load_factor: float
     iterations: int
@@ -48,6 +52,7 @@ def step_load(
         min_fraction: smallest step allowed, as a fraction of the total load.
         easy_iterations: a step that converged in at most this many iterations lets the next
             step grow by ``growth`` (never beyond the initial step size).
+        growth: factor by which an easy step's successor grows.
         on_step: called with each accepted :class:`LoadStep` (to write output as it goes).
         log: callable for one-line progress messages.
 

@@ -12,6 +12,8 @@ DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
 @dataclass(frozen=True)
 class Beam:
+    """A beam: centre line, section, mesh (elements, degree) and section orientation."""
+
     name: str
     curve: object
     section: Section
@@ -94,6 +96,8 @@ class PointMass:
 
 @dataclass(frozen=True)
 class Model:
+    """The whole structure: beams, supports, loads, springs, masses and kinematics options."""
+
     beams: tuple
     supports: tuple = ()
     point_loads: tuple = ()
@@ -104,6 +108,7 @@ class Model:
     point_masses: tuple = ()
 
     def beam(self, name):
+        """The beam named ``name`` (KeyError if none)."""
         for b in self.beams:
             if b.name == name:
                 return b

@@ -37,8 +37,8 @@ def _default_dir():
 
 
 def _time_label(folder, time):
-    """ "load factor 1", "t = 0.2 s" or "mode 3", from the analysis in results.json (written
-    at the end of a run; a run still going is labelled by its step value)."""
+    """Frame label ("load factor 1", "t = 0.2 s" or "mode 3") from the analysis in results.json
+    (written at the end of a run; a run still going is labelled by its step value)."""
     import json
 
     try:
@@ -152,6 +152,7 @@ def save_png(view, path, size=(1200, 900)):
 
 
 def main(argv=None):
+    """Command line: open a results folder in ParaView, or save its picture (``--png``)."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--dir", default=_default_dir(), help="results folder (default: this one)")
     p.add_argument("--png", help="save a picture here instead of staying open")

@@ -130,6 +130,7 @@ def image_stats(path):
 
 
 def main(argv=None):
+    """Command line: check a results folder in pvpython (tip position, picture)."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("dir", help="results folder of beamfx run")
     p.add_argument("--png", help="render the picture to this file")
