@@ -2,6 +2,7 @@
 unloaded state or, under loads, about the pre-stressed one; one frame per mode."""
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -11,6 +12,9 @@ from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
+
+if TYPE_CHECKING:
+    from ..spec import Model
 
 ROTARY = ("full", "polar", "none")
 
@@ -25,14 +29,15 @@ class Settings:
     prestress: bool = option(True, doc="about the static state under the scene's loads")
     steps: int = option(10, positive=True, doc="load steps of the pre-stressing solve")
 
-    def free_body(self, model):
+    def free_body(self, spec: "Model") -> bool:
         """A structure without supports has its rigid-body modes at 0 Hz; only pre-stress
         (a static solve) needs supports."""
-        return not (self.prestress and _loaded(model))
+        return not (self.prestress and _loaded(spec))
 
 
-def _loaded(model):
-    return bool(model.point_loads or model.distributed_loads or any(model.gravity))
+def _loaded(spec):
+    """Whether the scene's model (a :class:`~beamfx.spec.Model`) carries any load."""
+    return bool(spec.point_loads or spec.distributed_loads or any(spec.gravity))
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -20,6 +20,7 @@ from .result import Result as _Base
 from .result import entry
 
 if TYPE_CHECKING:  # heavy (UFL, PETSc): imported where used
+    from ..spec import Model
     from .transient import TransientSettings
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
@@ -63,7 +64,7 @@ class Settings:
     start: str = option("rest", choices=("rest", "static"), doc="from rest or a static state")
     steps: int = option(10, positive=True, doc="load steps of a static start")
 
-    def free_body(self, model):
+    def free_body(self, spec: "Model") -> bool:
         """A free structure may fly from rest (the mass makes the step's operator regular);
         a static start needs supports."""
         return self.start == "rest"
