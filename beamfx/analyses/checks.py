@@ -162,6 +162,15 @@ def check_supports_for(model, settings):
         check_supported(model)
 
 
+def leaves_plane(load, beams, n, off):
+    """Whether a load's force leaves the plane normal to axis ``n`` or its moment turns out of
+    it (a distributed load in section axes, along the beams it acts on)."""
+    pairs = load.directions(beams) if hasattr(load, "directions") else [(load.force, load.moment)]
+    scale = max((np.abs(np.r_[f, m]).max() for f, m in pairs), default=0.0)
+    tol = 1e-12 * scale
+    return any(abs(f[n]) > tol or any(abs(m[i]) > tol for i in off) for f, m in pairs)
+
+
 def check_planar(model):
     """Raise ValueError if a planar model's geometry or loads leave its plane."""
     from ..physics.kinematics import PLANES
@@ -176,7 +185,7 @@ def check_planar(model):
         if np.ptp(x[:, n]) > tol:
             raise ValueError(f"planar model ({plane}): beam {b.name!r} leaves the plane")
     for ld in (*model.point_loads, *model.distributed_loads):
-        if ld.force[n] or any(ld.moment[i] for i in range(3) if i != n):
+        if leaves_plane(ld, model.beams, n, [i for i in range(3) if i != n]):
             raise ValueError(
                 f"planar model ({plane}): a load has out-of-plane components "
                 f"(force {list(ld.force)}, moment {list(ld.moment)})"

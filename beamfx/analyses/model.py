@@ -96,9 +96,10 @@ class BeamModel(Discretised):
             return ufl.as_vector([float(c) for c in x])
 
         def work_of(load):
-            return energy.load_work(
-                kin, rot, v_u, v_rot, vec(load.force), vec(load.moment), load.kind, load.arm
-            )
+            force, moment = vec(load.force), vec(load.moment)
+            if getattr(load, "axes", "global") == "section":  # components in Λ0's axes
+                force, moment = d.Lam0 * force, d.Lam0 * moment
+            return energy.load_work(kin, rot, v_u, v_rot, force, moment, load.kind, load.arm)
 
         work = 0
         for ld in spec.point_loads:

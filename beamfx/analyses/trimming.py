@@ -32,7 +32,7 @@ import numpy as np
 from ..geometry.frames import section_axes_at
 from ..physics.kinematics import PLANES
 from ..spec import DOF_NAMES, resolve_point
-from .checks import free_rigid_modes, model_size
+from .checks import free_rigid_modes, leaves_plane, model_size
 
 #: analyses whose answer includes out-of-plane motion of a plane structure
 NEVER_TRIMMED = ("modal", "buckling", "rotating")
@@ -85,7 +85,7 @@ def _principal(model, n):
 def _loads(model, n):
     off = [i for i in range(3) if i != n]
     for ld in (*model.point_loads, *model.distributed_loads):
-        if ld.force[n] or any(ld.moment[i] for i in off):
+        if leaves_plane(ld, model.beams, n, off):
             return f"a load (force {list(ld.force)}, moment {list(ld.moment)}) leaves the plane"
     if model.gravity[n]:
         return f"gravity {list(model.gravity)} leaves the plane"

@@ -451,6 +451,9 @@ def _loads(top):
                 )
             )
         else:
+            axes = t.get("axes", str, "global", choices=("global", "section"))
+            if axes == "section" and kind == "quasitangential":
+                t.fail("axes", "a quasitangential moment's arm is global: give axes = 'global'")
             distributed.append(
                 DistributedLoad(
                     t.get("beam", str, None),
@@ -459,6 +462,7 @@ def _loads(top):
                     kind,
                     _history(t),
                     arm=_arm(t, kind, "moment_per_length"),
+                    axes=axes,
                 )
             )
         t.done(

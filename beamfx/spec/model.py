@@ -64,7 +64,9 @@ class PointLoad:
 @dataclass(frozen=True)
 class DistributedLoad:
     """Force and moment per unit reference length on ``beam`` (all beams if None); ``kind``
-    and ``arm`` as in :class:`PointLoad`."""
+    and ``arm`` as in :class:`PointLoad`. ``axes``: "global", or "section" for components in
+    the section axes of the undeformed beam (a radial load on an arc: then a dead load keeps
+    the undeformed radial direction and a follower load turns with the section, a pressure)."""
 
     beam: str | None = None
     force: tuple = (0.0, 0.0, 0.0)
@@ -72,6 +74,25 @@ class DistributedLoad:
     kind: str = "dead"
     history: object = None  # f(t) scaling force and moment in a transient (None: 1)
     arm: tuple | None = None
+    axes: str = "global"
+
+    def directions(self, beams):
+        """The global force and moment per length along ``beams`` (sampled at 101 points of
+        each), for checks of where the load points: ``[(force, moment)]``."""
+        from ..geometry.frames import section_axes_at
+
+        if self.axes == "global":
+            return [(np.asarray(self.force, float), np.asarray(self.moment, float))]
+        out = []
+        for b in beams:
+            if self.beam is not None and b.name != self.beam:
+                continue
+            for s in np.linspace(0.0, b.curve.length, 101):
+                lam = section_axes_at(b.curve, s, b.orientation, b.twist_deg)
+                out.append(
+                    (lam @ np.asarray(self.force, float), lam @ np.asarray(self.moment, float))
+                )
+        return out
 
 
 @dataclass(frozen=True)
