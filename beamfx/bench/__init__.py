@@ -22,6 +22,7 @@ def all_cases():
         schwab_meijaard_eigen,
         schwab_meijaard_rotating,
         schwab_meijaard_torque,
+        shallow_arch,
         transient,
     )
 

@@ -1,7 +1,9 @@
 """A bench setting as the scene a user would run, and its run through ``beamfx run``'s path."""
 
 import time
-from dataclasses import fields
+from dataclasses import dataclass, fields
+
+from .registry import Case
 
 
 def case_scene(case, elements, degree, analysis="static", **settings):
@@ -51,3 +53,50 @@ def run_scenes(runs, folder):
         total += seconds
         values.update(read(run.result))
     return done, total, values
+
+
+def _solve_only(seconds):
+    """The analysis's own assembly and solve time from its ``seconds`` split."""
+    keys = ("assemble_F", "assemble_J", "solve", "assemble")
+    return sum(float(seconds.get(k, 0.0)) for k in keys)
+
+
+@dataclass(frozen=True)
+class SceneCase(Case):
+    """A case whose setting is one or more scenes: ``build(elements, degree)`` returns
+    ``[(scene, read)]``, ``read(result)`` the named values of a run's result (eigen analyses,
+    arc-length traces: values a probe cannot give). :meth:`run_setting` runs them through
+    ``beamfx run``'s path (cold, then warm)."""
+
+    def scenes(self, elements, degree):
+        """The scenes of one setting, for a process of their own (:mod:`.process`)."""
+        return [scene for scene, _ in self.build(elements, degree)]
+
+    def run_setting(self, elements, degree):
+        """Cold and warm whole runs of the setting's scenes; solve only = the analyses' own
+        assembly and solves (Newton's, or the eigen solver's)."""
+        import tempfile
+
+        from ..solvers.forms import compile_seconds
+
+        c0 = compile_seconds[0]
+        with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
+            _, cold, _ = run_scenes(self.build(elements, degree), folder)
+            jit = compile_seconds[0] - c0
+            runs, warm, values = run_scenes(self.build(elements, degree), folder)
+        solve = sum(
+            r.result.seconds.get("assemble", 0.0) + r.result.seconds.get("solve", 0.0) for r in runs
+        )
+        return {
+            "elements": elements,
+            "degree": degree,
+            "unknowns": runs[0].model["unknowns"],
+            "newton_iterations": sum(r.result.newton_iterations for r in runs),
+            "load_steps": sum(len(r.result.load_steps) for r in runs),
+            "wall_s_cold": cold,
+            "wall_s_whole": warm,
+            "wall_s_warm": solve,
+            "jit_s": jit,
+            "warm_split_s": {},
+            "values": {k: float(v) for k, v in self.measure(values).items()},
+        }

@@ -20,6 +20,7 @@ from ..physics.kinematics import Kinematics
 from ..spec import Beam, Model, PointLoad, Support
 from ._builders import cantilever, straight
 from .registry import Case, reference, register
+from .scenes import SceneCase
 
 FILE = "schwab_meijaard_2009.json"
 MAT = reference(FILE)["material"]
@@ -58,47 +59,6 @@ class EigenCase(Case):
             "load_steps": 1 if its else 0,
             "wall_s_cold": cold,
             "wall_s_warm": warm,
-            "jit_s": jit,
-            "warm_split_s": {},
-            "values": {k: float(v) for k, v in self.measure(values).items()},
-        }
-
-
-@dataclass(frozen=True)
-class SceneEigenCase(Case):
-    """A case whose setting is one or more eigen analyses run as scenes: ``build(elements,
-    degree)`` returns ``[(scene, read)]``, ``read(result)`` the named values of a run's result.
-    :meth:`run_setting` runs them through ``beamfx run``'s path (cold, then warm)."""
-
-    def scenes(self, elements, degree):
-        """The scenes of one setting, for a process of their own (:mod:`.process`)."""
-        return [scene for scene, _ in self.build(elements, degree)]
-
-    def run_setting(self, elements, degree):
-        """Cold and warm whole runs of the setting's scenes; solve only = the eigen (and
-        pre-stress Newton) assembly and solves."""
-        import tempfile
-
-        from ..solvers.forms import compile_seconds
-        from .scenes import run_scenes
-
-        c0 = compile_seconds[0]
-        with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
-            _, cold, _ = run_scenes(self.build(elements, degree), folder)
-            jit = compile_seconds[0] - c0
-            runs, warm, values = run_scenes(self.build(elements, degree), folder)
-        solve = sum(
-            r.result.seconds.get("assemble", 0.0) + r.result.seconds.get("solve", 0.0) for r in runs
-        )
-        return {
-            "elements": elements,
-            "degree": degree,
-            "unknowns": runs[0].model["unknowns"],
-            "newton_iterations": sum(r.result.newton_iterations for r in runs),
-            "load_steps": sum(len(r.result.load_steps) for r in runs),
-            "wall_s_cold": cold,
-            "wall_s_whole": warm,
-            "wall_s_warm": solve,
             "jit_s": jit,
             "warm_split_s": {},
             "values": {k: float(v) for k, v in self.measure(values).items()},
@@ -150,7 +110,7 @@ def _euler(n, p):
 
 
 register(
-    SceneEigenCase(
+    SceneCase(
         "sm25_euler_buckling",
         "Schwab & Meijaard 2009, 2.5",
         "Euler buckling of a cantilever, linear buckling analysis",
@@ -181,7 +141,7 @@ def _lateral(n, p):
 
 
 register(
-    SceneEigenCase(
+    SceneCase(
         "sm26_lateral_buckling",
         "Schwab & Meijaard 2009, 2.6",
         "Lateral (flexural-torsional) buckling of a cantilever under a tip force",
@@ -228,7 +188,7 @@ def _free_free(n, p):
 
 
 register(
-    SceneEigenCase(
+    SceneCase(
         "sm28_free_free_eigen",
         "Schwab & Meijaard 2009, 2.8",
         "Free-free beam: axial, torsional and first two bending frequencies",
@@ -266,7 +226,7 @@ _DROP = {
 }
 
 register(
-    SceneEigenCase(
+    SceneCase(
         "sm28_free_free_timoshenko",
         "Schwab & Meijaard 2009, 2.8 (Timoshenko)",
         "Free-free beam with shear and rotary inertia: frequencies / Euler-Bernoulli theory",
@@ -328,7 +288,7 @@ def _prestressed(n, p):
 
 
 register(
-    SceneEigenCase(
+    SceneCase(
         "sm29_prestressed",
         "Schwab & Meijaard 2009, 2.9",
         "Simply supported beam under tension F: first bending frequency",
