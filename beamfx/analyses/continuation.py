@@ -24,6 +24,8 @@ class PathPoint(NamedTuple):
     displacement: np.ndarray  # (3,) at the control point, global axes
     iterations: int  # corrector iterations of the step that reached it (0 at the start)
     arc_length: float  # s, the path length from the start (measured on the displacement dofs)
+    negative_eigenvalues: int | None = None  # of the tangent (None: not counted)
+    note: str = ""  # "bifurcation point" or "branch switch"
 
 
 class LimitPoint(NamedTuple):
@@ -42,7 +44,9 @@ class ContinuationResult(NamedTuple):
     control_point: str
     steps: tuple  # ArcLengthStep records of the solver
     reason: str  # why the trace ended: "target", "stop" (displacement limit, stop), "max_steps"
-    seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, total
+    seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, inertia, locate,
+    # total
+    critical_points: tuple = ()  # CriticalPoint records (beamfx.solvers.bifurcation)
 
     @property
     def load_factors(self):
@@ -152,8 +156,9 @@ def trace_path(
 
     def record(step):
         s = path[-1].arc_length + step.arc_length
+        u = point_displacement(model, dofs)
         path.append(
-            PathPoint(step.load_factor, point_displacement(model, dofs), step.iterations, s)
+            PathPoint(step.load_factor, u, step.iterations, s, step.negative_eigenvalues, step.note)
         )
         if on_step:
             on_step(path[-1])
@@ -171,7 +176,10 @@ def trace_path(
         solver.destroy()
     model.set_load_factor(float(model.load_factor.value))  # the support values follow λ
     seconds = {"compile": compile_time, **result.seconds, "total": time.perf_counter() - t0}
-    return ContinuationResult(tuple(path), control_point, result.steps, result.reason, seconds)
+    path[0] = path[0]._replace(negative_eigenvalues=result.negative_eigenvalues)
+    return ContinuationResult(
+        tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
+    )
 
 
 def limit_points(path):

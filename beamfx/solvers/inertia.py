@@ -24,7 +24,6 @@ DEFAULT_OPTIONS = {
     "ksp_type": "preonly",
     "pc_type": "cholesky",
     "pc_factor_mat_solver_type": "mumps",
-    "mat_mumps_icntl_13": 1,
 }
 
 
@@ -32,6 +31,16 @@ def counts_inertia(ksp):
     """Whether ``ksp`` factorises with MUMPS's symmetric LDLᵀ (so INFOG(12) is the inertia)."""
     pc = ksp.getPC()
     return pc.getType() == "cholesky" and pc.getFactorSolverType() == "mumps"
+
+
+def prepare(ksp):
+    """Before the first factorisation of ``ksp`` (operators set): keep MUMPS's root front off
+    ScaLAPACK, ICNTL(13) = 1, so that INFOG(12) counts every pivot (the options database
+    does not reach the factor through the KSP's prefix in PETSc 3.18)."""
+    if counts_inertia(ksp):
+        pc = ksp.getPC()
+        pc.setFactorSetUpSolverType()
+        pc.getFactorMatrix().setMumpsIcntl(13, 1)
 
 
 def negative_pivots(ksp):
@@ -71,6 +80,8 @@ class InertiaCounter:
         """The number of negative eigenvalues of the assembled symmetric matrix ``A``."""
         t = time.perf_counter()
         self.ksp.setOperators(A)
+        if self.calls == 0:
+            prepare(self.ksp)
         self.ksp.setUp()
         n = negative_pivots(self.ksp)
         self.seconds += time.perf_counter() - t
