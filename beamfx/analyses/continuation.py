@@ -131,10 +131,7 @@ def trace_path(
             )
         comp = DOF_NAMES.index(comp)
 
-    # the load vector depends on the state for follower and semitangential loads, and for
-    # fixed moments under finite rotations (their work is M·δθ with δθ a function of q)
-    loads = (*spec.point_loads, *spec.distributed_loads)
-    follower = any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)
+    follower = state_dependent_loads(model)
     base = settings or ArcLengthSettings()
     settings = replace(base, follower=base.follower or follower)
     c0 = compile_seconds[0]
@@ -180,6 +177,14 @@ def trace_path(
     return ContinuationResult(
         tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
     )
+
+
+def state_dependent_loads(model):
+    """Whether the load vector depends on the state (then the tangent is unsymmetric): for
+    follower and semitangential loads, and for fixed moments under finite rotations (their
+    work is M·δθ with δθ a function of q)."""
+    loads = (*model.spec.point_loads, *model.spec.distributed_loads)
+    return any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)
 
 
 def limit_points(path):

@@ -17,7 +17,9 @@ the step is redone to x (same constraint, same predictor) and the eigenvalue μ(
 zero computed by inverse iteration with the factorisation (:func:`smallest_eigenpair`). The
 root of μ(x) is sought by regula falsi with the Illinois modification inside a bracket that
 the inertia keeps (a probe belongs to the side whose count it has); bisection when μ does not
-change sign across the bracket (another eigenvalue is nearer zero). Not an extended system.
+change sign across the bracket (another eigenvalue is nearer zero). A probe whose μ has the
+sign of the other side is at round-off from the root and ends the search. Not an extended
+system.
 
 **Branch switching** (mode injection): from the located point (w_c, λ_c), the first step on
 the secondary branch starts from the predictor Δw = ξ φ, Δλ = 0 with ξ φ of arc length
@@ -121,6 +123,8 @@ def locate(probe, end, before, tol, max_probes=40):
         x = b - fb * (b - a) / (fb - fa) if secant else 0.5 * (a + b)
         count, mu = probe(x)
         n += 1
+        if (count == before) != (mu > 0) and (fa > 0) == (count == before):
+            return x, n  # μ's sign disagrees with the inertia: it is at round-off, zero
         if count == before:
             a, fa = x, mu
             fb = 0.5 * fb if stale == "b" else fb  # Illinois: the end kept twice weighs less
