@@ -191,7 +191,8 @@ def limit_points(path):
     """Local extrema of the load factor along a path, located by a parabola in s.
 
     The parabola through the three path points around a discrete extremum, λ(s) and u(s)
-    quadratic in the arc length s, places the limit point with an error O(Δs³).
+    quadratic in the arc length s, places the limit point with an error O(Δs³). Points where
+    the path switches branch (a ``note``) are no extrema of a smooth path and are skipped.
 
     Args:
         path: sequence of :class:`PathPoint` (``ContinuationResult.path``).
@@ -205,8 +206,8 @@ def limit_points(path):
     out = []
     for i in range(1, len(path) - 1):
         rise, fall = lam[i] - lam[i - 1], lam[i + 1] - lam[i]
-        if rise * fall >= 0:
-            continue
+        if rise * fall >= 0 or any(getattr(p, "note", "") for p in path[i - 1 : i + 2]):
+            continue  # no extremum, or the path changes branch there (not smooth)
         x = s[i - 1 : i + 2]
         c = np.polyfit(x - x[1], lam[i - 1 : i + 2], 2)
         ds = -c[1] / (2 * c[0])
