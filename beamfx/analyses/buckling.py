@@ -238,14 +238,7 @@ def solve_buckling(
     import dolfinx.fem.petsc as fp
     from dolfinx import fem
 
-    if about not in ("undeformed", "current"):
-        raise ValueError(f"about must be 'undeformed' or 'current', got {about!r}")
-    if kg not in ("stress", "path"):
-        raise ValueError(f"kg must be 'stress' or 'path', got {kg!r}")
-    if sign not in SIGNS:
-        raise ValueError(f"sign must be one of {SIGNS}, got {sign!r}")
-    if not model.kin.finite:
-        raise ValueError("buckling needs the finite kinematics: the linear model has no K_g")
+    _check(model, about, kg, sign)
     t0 = time.perf_counter()
     if about == "undeformed":
         model.reset()
@@ -294,6 +287,18 @@ def solve_buckling(
         seconds,
         negative,
     )
+
+
+def _check(model, about, kg, sign):
+    """Raise ValueError for a bad option or the linear kinematics."""
+    if about not in ("undeformed", "current"):
+        raise ValueError(f"about must be 'undeformed' or 'current', got {about!r}")
+    if kg not in ("stress", "path"):
+        raise ValueError(f"kg must be 'stress' or 'path', got {kg!r}")
+    if sign not in SIGNS:
+        raise ValueError(f"sign must be one of {SIGNS}, got {sign!r}")
+    if not model.kin.finite:
+        raise ValueError("buckling needs the finite kinematics: the linear model has no K_g")
 
 
 def _inertia(model, K):
