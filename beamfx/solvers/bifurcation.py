@@ -65,8 +65,14 @@ class CriticalPoint(NamedTuple):
 
 
 def classify(before, after, forward_before, forward_after):
-    """ "limit", "bifurcation" or None for a step from inertia ``before`` to ``after`` with the
-    predictor's load direction (±1) ``forward_before`` and ``forward_after`` at its ends."""
+    """The kind of critical point a step passed: "limit", "bifurcation" or None.
+
+    Args:
+        before: the inertia (negative eigenvalues) at the step's start.
+        after: the inertia at its end.
+        forward_before: the predictor's load direction (±1) at the start.
+        forward_after: the same at the end.
+    """
     if before is None or after is None or before == after:
         return None
     return "limit" if forward_before != forward_after else "bifurcation"
@@ -77,8 +83,11 @@ def smallest_eigenpair(A, solve, x, its=60, rtol=1e-9):
     x ← A⁻¹x / ‖A⁻¹x‖ with the factorisation in ``solve(rhs, out)``; μ = xᵀAx.
 
     Args:
+        A: the assembled matrix (PETSc Mat).
+        solve: ``solve(rhs, out)``: out = A⁻¹ rhs with A's factorisation.
         x: PETSc Vec, the starting vector; holds the unit eigenvector on return.
-        its, rtol: stop after ``its`` iterations or when ‖Ax − μx‖ ≤ rtol ‖A‖∞.
+        its: at most this many iterations.
+        rtol: stop when ‖Ax − μx‖ ≤ rtol ‖A‖∞.
 
     Returns:
         (μ, iterations)
@@ -110,7 +119,9 @@ def locate(probe, end, before, tol, max_probes=40):
         probe: ``probe(x) -> (count, μ)``: inertia and eigenvalue nearest zero at the point of
             the path at arc length x from the start of the step (collective).
         end: the step's arc length; probe(0) has count ``before``, probe(end) another.
+        before: the inertia at the step's start.
         tol: stop when the bracket, or the last move of the estimate, is below tol · end.
+        max_probes: at most this many probes.
 
     Returns:
         (x_c, probes): the last estimate, at which ``probe`` was evaluated last.

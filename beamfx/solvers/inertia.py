@@ -89,6 +89,7 @@ class InertiaCounter:
         return n
 
     def destroy(self):
+        """Free the factorisation."""
         self.ksp.destroy()
 
 
