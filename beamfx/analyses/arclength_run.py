@@ -56,7 +56,7 @@ class Settings:
     switch_amplitude: float | None = option(
         None,
         positive=True,
-        doc="arc length of the first step along the buckling mode (default: the last step's)",
+        doc="arc length of the first step along the buckling mode (default: 1 % of the size)",
     )
 
     def points(self) -> tuple[str, ...]:

@@ -134,6 +134,8 @@ def trace_path(
     follower = state_dependent_loads(model)
     base = settings or ArcLengthSettings()
     settings = replace(base, follower=base.follower or follower)
+    if settings.switch_amplitude is None:  # far enough from the bifurcation for its inertia
+        settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
     c0 = compile_seconds[0]
     u_dofs = subspace_dofs(model.W, 0)
     solver = ArcLengthSolver(
@@ -177,6 +179,21 @@ def trace_path(
     return ContinuationResult(
         tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
     )
+
+
+#: default arc length of the first step onto a secondary branch, as a fraction of the model's
+#: size: at 1e-2 the eigenvalue of the tangent that passed zero has grown to about 1e-4 of
+#: its scale on an Euler column's branch (far above round-off, so the inertia is certain)
+SWITCH_AMPLITUDE = 1e-2
+
+
+def model_size(model):
+    """The largest extent of the model's mesh along x, y or z (collective)."""
+    from mpi4py import MPI
+
+    x = model.mesh.mesh.geometry.x
+    local = float(np.ptp(x, axis=0).max()) if len(x) else 0.0
+    return model.comm.allreduce(local, op=MPI.MAX)
 
 
 def state_dependent_loads(model):
