@@ -1,5 +1,7 @@
 """Arc-length continuation of a scene (``[analysis] type = "arclength"``): the equilibrium path
-through limit points, written to ``path.csv`` as it goes, its limit points in the results."""
+through limit points, written to ``path.csv`` as it goes, its limit points in the results; the
+inertia of the tangent at every point, the critical points it passes, bifurcations located and
+(``branch = "secondary"``) the secondary branch followed from the first one."""
 
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -40,6 +42,22 @@ class Settings:
         word="[component, value], component ux, uy or uz",
         doc="stop when the control point's displacement component passes the value",
     )
+    max_arc_length: float | None = option(
+        None, positive=True, doc="largest arc length of a step (default: 10 first arc lengths)"
+    )
+    min_arc_length: float | None = option(
+        None, positive=True, doc="smallest arc length before failing (default: 1e-4 of the first)"
+    )
+    branch: str = option(
+        "primary",
+        choices=("primary", "secondary"),
+        doc="at the first bifurcation: go on along the path, or switch to the secondary branch",
+    )
+    switch_amplitude: float | None = option(
+        None,
+        positive=True,
+        doc="arc length of the first step along the buckling mode (default: 1 % of the size)",
+    )
 
     def points(self) -> tuple[str, ...]:
         """Named points the model must have beyond the scene's probes."""
@@ -69,10 +87,18 @@ class Result(_Base):
     path: tuple = entry("load factor, displacement and arc length of every accepted point")
     limit_points: tuple = entry("maxima and minima of the load factor along the path")
     stopped_by: str = entry("target, stop (displacement limit) or max_steps")
+    critical_points: tuple = entry(
+        "limit and bifurcation points passed: where the number of negative eigenvalues of the "
+        "tangent changed, the step and load-factor interval, the located load factor"
+    )
 
     def summary(self) -> dict:
-        """The numbers of a sweep table: the limit points and why the trace stopped."""
-        return {"limit_points": list(self.limit_points), "stopped_by": self.stopped_by}
+        """The numbers of a sweep table: limit and critical points, why the trace stopped."""
+        return {
+            "limit_points": list(self.limit_points),
+            "critical_points": [(c["kind"], c["load_factor"]) for c in self.critical_points],
+            "stopped_by": self.stopped_by,
+        }
 
 
 def _csv_writer(ctx):
@@ -80,13 +106,19 @@ def _csv_writer(ctx):
     csv = ctx.folder / "path.csv"
     root = ctx.comm.rank == 0
     if root:
-        csv.write_text("step,load_factor,ux,uy,uz,arc_length,iterations\n")
+        csv.write_text(
+            "step,load_factor,ux,uy,uz,arc_length,iterations,negative_eigenvalues,note\n"
+        )
 
     def record(index, p):
         if root:
             u = ",".join(f"{x:.12g}" for x in p.displacement)
+            n = "" if p.negative_eigenvalues is None else p.negative_eigenvalues
             with csv.open("a") as f:
-                f.write(f"{index},{p.load_factor:.12g},{u},{p.arc_length:.12g},{p.iterations}\n")
+                f.write(
+                    f"{index},{p.load_factor:.12g},{u},{p.arc_length:.12g},{p.iterations},"
+                    f"{n},{p.note}\n"
+                )
 
     return record
 
@@ -108,23 +140,44 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         model,
         **{k: getattr(settings, k) for k in keys},
         displacement_limit=settings.displacement_limit,
-        settings=ArcLengthSettings(method=settings.method),
+        settings=ArcLengthSettings(
+            method=settings.method,
+            bounds=(settings.min_arc_length, settings.max_arc_length),
+            branch=settings.branch,
+            switch_amplitude=settings.switch_amplitude,
+        ),
         options=ctx.solver_options,
         on_step=on_step,
         log=ctx.log,
     )
     path = [
-        {"load_factor": p.load_factor, "displacement": p.displacement, "arc_length": p.arc_length}
+        {
+            "load_factor": p.load_factor,
+            "displacement": p.displacement,
+            "arc_length": p.arc_length,
+            "negative_eigenvalues": p.negative_eigenvalues,
+            **({"note": p.note} if p.note else {}),
+        }
         for p in result.path
     ]
+    found = limit_points(result.path)
     limits = [
         {"kind": p.kind, "load_factor": p.load_factor, "displacement": p.displacement}
-        for p in limit_points(result.path)
+        for p in found
     ]
     for p in limits:
         ctx.log(
             f"  limit point ({p['kind']}): load factor {p['load_factor']:.6g} "
             f"at {result.control_point}"
+        )
+    critical = critical_points(result, found)
+    for c in critical:
+        ctx.log(
+            f"  {c['kind']} point passed in step {c['step']} (load factor "
+            f"{c['interval'][0]:.6g} to {c['interval'][1]:.6g}, negative eigenvalues "
+            f"{c['negative_eigenvalues'][0]} -> {c['negative_eigenvalues'][1]})"
+            + (f": at load factor {c['load_factor']:.8g}" if c["load_factor"] is not None else "")
+            + (", secondary branch followed from here" if c["switched"] else "")
         )
     short = result.reason == "max_steps"  # neither the target nor the limit was reached
     why = f"max_steps: {settings.max_steps} steps did not reach the end asked for"
@@ -139,7 +192,36 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         path=tuple(path),
         limit_points=tuple(limits),
         stopped_by=result.reason,
+        critical_points=tuple(critical),
     )
+
+
+def critical_points(result, limits):
+    """The critical points of a :class:`~beamfx.analyses.continuation.ContinuationResult` as
+    results.json entries; a limit point gets the load factor of the path's extremum within
+    its step (``limits``: :func:`~beamfx.analyses.continuation.limit_points`)."""
+    s = [p.arc_length for p in result.path]
+    out = []
+    for c in result.critical_points:
+        lam = c.load_factor
+        if c.kind == "limit":
+            near = [
+                p
+                for p in limits
+                if s[max(c.step - 2, 0)] <= p.arc_length <= s[min(c.step + 1, len(s) - 1)]
+            ]
+            lam = near[0].load_factor if near else None
+        out.append(
+            {
+                "kind": c.kind,
+                "step": c.step,
+                "interval": list(c.interval),
+                "load_factor": lam,
+                "negative_eigenvalues": [c.negative_before, c.negative_after],
+                "switched": c.switched,
+            }
+        )
+    return out
 
 
 ANALYSES = (Analysis("arclength", Settings, run, doc="equilibrium path past limit points"),)

@@ -22,6 +22,12 @@ prescribed values on the constrained dofs. Two choices of K_g (``kg``):
 pre-stress from one linear solve under the reference load (load factor 1) about the
 undeformed state, critical load factors = μ. ``about="current"``: about the current
 (pre-loaded, deformed) ``model.w`` at the current load factor λ*, critical factors λ* + μ.
+
+``sign``: the roots μ > 0 (loads increased, the default), μ < 0 (loads reversed: a column in
+tension buckles at −P_cr) or both, nearest zero first. The inertia of K* (its negative
+eigenvalues, :mod:`beamfx.solvers.inertia`) says how many critical points the state has
+passed: beyond one, the lowest positive root is not the first buckling load, and the roots
+below λ* (μ < 0) are those passed.
 """
 
 import time
@@ -37,17 +43,20 @@ from ..solvers.forms import compile_form
 from .dofs import constrained_dofs, subspace_dofs
 from .modal import to_functions
 
+SIGNS = ("positive", "negative", "both")
+
 
 class BucklingResult(NamedTuple):
     """Critical load factors, their modes and the pre-stress path of a buckling analysis."""
 
-    load_factors: np.ndarray  # critical load factors λ* + μ, lowest positive μ first
+    load_factors: np.ndarray  # critical load factors λ* + μ, smallest |μ| of the sign first
     increments: np.ndarray  # μ: load factor beyond the state analysed
     modes: tuple  # dolfinx Functions on model.W
     residuals: np.ndarray
     path: object  # dolfinx Function: dw/dλ at the state analysed (the linear pre-stress state
     # per unit load factor for about="undeformed")
     seconds: dict
+    negative_eigenvalues: int | None = None  # of K* (None: non-conservative loads, not counted)
 
 
 def _tangent(A, J_form, bcs, diagonal):
@@ -196,6 +205,13 @@ def _scaled_max(model, f):
     return model.comm.allreduce(local, op=MPI.MAX)
 
 
+def _keep(mu, sign, n_modes):
+    """Indices of the real roots μ of ``sign`` (:data:`SIGNS`), nearest zero first."""
+    real = [i for i in range(len(mu)) if abs(mu[i].imag) <= 1e-8 * abs(mu[i])]
+    wanted = {"positive": lambda m: m > 0, "negative": lambda m: m < 0, "both": lambda m: True}
+    return sorted((i for i in real if wanted[sign](mu[i].real)), key=lambda i: abs(mu[i]))[:n_modes]
+
+
 def solve_buckling(
     model,
     n_modes=4,
@@ -204,14 +220,17 @@ def solve_buckling(
     options=None,
     prefix="beamfx_buckling_",
     eps=1e-4,
+    sign="positive",
 ):
-    """The ``n_modes`` lowest positive critical load factors and their modes.
+    """The ``n_modes`` critical load factors of ``sign`` nearest the state, and their modes.
 
     Solves K* x = μ (−K_g) x (GNHEP: with non-conservative loads K_g is unsymmetric) by
-    shift-and-invert at μ = 0 and keeps the real positive μ. ``about``: "undeformed" (the
-    classical linear buckling analysis; the model is left undeformed at load factor 0) or
-    "current" (about ``model.w`` at the current load factor, both left unchanged). ``kg``:
-    "stress" or "path" (module doc); ``eps`` is the relative step of "path".
+    shift-and-invert at μ = 0 and keeps the real μ of ``sign`` ("positive", "negative" or
+    "both"), nearest zero first. ``about``: "undeformed" (the classical linear buckling
+    analysis; the model is left undeformed at load factor 0) or "current" (about ``model.w``
+    at the current load factor, both left unchanged). ``kg``: "stress" or "path" (module doc);
+    ``eps`` is the relative step of "path". The inertia of K* is counted for conservative
+    loads (``negative_eigenvalues``).
 
     Raises:
         ValueError: for the linear kinematics (no geometric stiffness) or a bad option.
@@ -219,12 +238,7 @@ def solve_buckling(
     import dolfinx.fem.petsc as fp
     from dolfinx import fem
 
-    if about not in ("undeformed", "current"):
-        raise ValueError(f"about must be 'undeformed' or 'current', got {about!r}")
-    if kg not in ("stress", "path"):
-        raise ValueError(f"kg must be 'stress' or 'path', got {kg!r}")
-    if not model.kin.finite:
-        raise ValueError("buckling needs the finite kinematics: the linear model has no K_g")
+    _check(model, about, kg, sign)
     t0 = time.perf_counter()
     if about == "undeformed":
         model.reset()
@@ -243,20 +257,19 @@ def solve_buckling(
     t3 = time.perf_counter()
     K = fp.assemble_matrix(J_form, bcs=model.bcs, diagonal=1.0)
     K.assemble()
+    negative = _inertia(model, K)
     if kg == "stress":
         Kg = stress_stiffness(model, J_form, S_form)
     else:
         Kg = geometric_stiffness(model, J_form, P_form, dw, eps)
     Kg.scale(-1.0)
     t4 = time.perf_counter()
-    nev = 2 * n_modes + 2  # roots of both signs come out; keep the positive ones
+    nev = 2 * n_modes + 2  # roots of both signs come out; keep those of the sign asked
     pairs = solve_eigen(K, Kg, nev, 0.0, prefix, options, hermitian=False)
     K.destroy()
     Kg.destroy()
     mu = pairs.values
-    keep = [
-        i for i in np.argsort(mu.real) if mu[i].real > 0 and abs(mu[i].imag) <= 1e-8 * abs(mu[i])
-    ][:n_modes]
+    keep = _keep(mu, sign, n_modes)
     for i in set(range(len(mu))) - set(keep):
         pairs.vectors[i].destroy()
     lam = float(model.load_factor.value)
@@ -272,4 +285,32 @@ def solve_buckling(
         pairs.residuals[keep],
         dw,
         seconds,
+        negative,
     )
+
+
+def _check(model, about, kg, sign):
+    """Raise ValueError for a bad option or the linear kinematics."""
+    if about not in ("undeformed", "current"):
+        raise ValueError(f"about must be 'undeformed' or 'current', got {about!r}")
+    if kg not in ("stress", "path"):
+        raise ValueError(f"kg must be 'stress' or 'path', got {kg!r}")
+    if sign not in SIGNS:
+        raise ValueError(f"sign must be one of {SIGNS}, got {sign!r}")
+    if not model.kin.finite:
+        raise ValueError("buckling needs the finite kinematics: the linear model has no K_g")
+
+
+def _inertia(model, K):
+    """Negative eigenvalues of the tangent ``K`` (None for state-dependent loads, whose
+    tangent is unsymmetric: no inertia)."""
+    from ..solvers.inertia import InertiaCounter
+    from .continuation import state_dependent_loads
+
+    if state_dependent_loads(model):
+        return None
+    counter = InertiaCounter(model.comm, "beamfx_buckling_inertia_")
+    try:
+        return counter.count(K)
+    finally:
+        counter.destroy()

@@ -24,6 +24,8 @@ class PathPoint(NamedTuple):
     displacement: np.ndarray  # (3,) at the control point, global axes
     iterations: int  # corrector iterations of the step that reached it (0 at the start)
     arc_length: float  # s, the path length from the start (measured on the displacement dofs)
+    negative_eigenvalues: int | None = None  # of the tangent (None: not counted)
+    note: str = ""  # "bifurcation point" or "branch switch"
 
 
 class LimitPoint(NamedTuple):
@@ -42,7 +44,9 @@ class ContinuationResult(NamedTuple):
     control_point: str
     steps: tuple  # ArcLengthStep records of the solver
     reason: str  # why the trace ended: "target", "stop" (displacement limit, stop), "max_steps"
-    seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, total
+    seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, inertia, locate,
+    # total
+    critical_points: tuple = ()  # CriticalPoint records (beamfx.solvers.bifurcation)
 
     @property
     def load_factors(self):
@@ -127,12 +131,11 @@ def trace_path(
             )
         comp = DOF_NAMES.index(comp)
 
-    # the load vector depends on the state for follower and semitangential loads, and for
-    # fixed moments under finite rotations (their work is M·δθ with δθ a function of q)
-    loads = (*spec.point_loads, *spec.distributed_loads)
-    follower = any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)
+    follower = state_dependent_loads(model)
     base = settings or ArcLengthSettings()
     settings = replace(base, follower=base.follower or follower)
+    if settings.switch_amplitude is None:  # far enough from the bifurcation for its inertia
+        settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
     c0 = compile_seconds[0]
     u_dofs = subspace_dofs(model.W, 0)
     solver = ArcLengthSolver(
@@ -152,8 +155,9 @@ def trace_path(
 
     def record(step):
         s = path[-1].arc_length + step.arc_length
+        u = point_displacement(model, dofs)
         path.append(
-            PathPoint(step.load_factor, point_displacement(model, dofs), step.iterations, s)
+            PathPoint(step.load_factor, u, step.iterations, s, step.negative_eigenvalues, step.note)
         )
         if on_step:
             on_step(path[-1])
@@ -171,14 +175,41 @@ def trace_path(
         solver.destroy()
     model.set_load_factor(float(model.load_factor.value))  # the support values follow λ
     seconds = {"compile": compile_time, **result.seconds, "total": time.perf_counter() - t0}
-    return ContinuationResult(tuple(path), control_point, result.steps, result.reason, seconds)
+    path[0] = path[0]._replace(negative_eigenvalues=result.negative_eigenvalues)
+    return ContinuationResult(
+        tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
+    )
+
+
+#: default arc length of the first step onto a secondary branch, as a fraction of the model's
+#: size: at 1e-2 the eigenvalue of the tangent that passed zero has grown to about 1e-4 of
+#: its scale on an Euler column's branch (far above round-off, so the inertia is certain)
+SWITCH_AMPLITUDE = 1e-2
+
+
+def model_size(model):
+    """The largest extent of the model's mesh along x, y or z (collective)."""
+    from mpi4py import MPI
+
+    x = model.mesh.mesh.geometry.x
+    local = float(np.ptp(x, axis=0).max()) if len(x) else 0.0
+    return model.comm.allreduce(local, op=MPI.MAX)
+
+
+def state_dependent_loads(model):
+    """Whether the load vector depends on the state (then the tangent is unsymmetric): for
+    follower and semitangential loads, and for fixed moments under finite rotations (their
+    work is M·δθ with δθ a function of q)."""
+    loads = (*model.spec.point_loads, *model.spec.distributed_loads)
+    return any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)
 
 
 def limit_points(path):
     """Local extrema of the load factor along a path, located by a parabola in s.
 
     The parabola through the three path points around a discrete extremum, λ(s) and u(s)
-    quadratic in the arc length s, places the limit point with an error O(Δs³).
+    quadratic in the arc length s, places the limit point with an error O(Δs³). Points where
+    the path switches branch (a ``note``) are no extrema of a smooth path and are skipped.
 
     Args:
         path: sequence of :class:`PathPoint` (``ContinuationResult.path``).
@@ -192,8 +223,8 @@ def limit_points(path):
     out = []
     for i in range(1, len(path) - 1):
         rise, fall = lam[i] - lam[i - 1], lam[i + 1] - lam[i]
-        if rise * fall >= 0:
-            continue
+        if rise * fall >= 0 or any(getattr(p, "note", "") for p in path[i - 1 : i + 2]):
+            continue  # no extremum, or the path changes branch there (not smooth)
         x = s[i - 1 : i + 2]
         c = np.polyfit(x - x[1], lam[i - 1 : i + 2], 2)
         ds = -c[1] / (2 * c[0])

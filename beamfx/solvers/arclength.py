@@ -34,6 +34,13 @@ through limit points and snap-backs). The next arc length is :math:`Δl (I_d / I
 (Crisfield 1981, eq. 25) for ``I`` iterations and a desired :math:`I_d`, bounded; a failed step is
 retried with half the arc length.
 
+Stability: with a symmetric tangent (no follower load) the linear solver is MUMPS's LDLᵀ,
+whose negative pivots count the negative eigenvalues of K (:mod:`beamfx.solvers.inertia`).
+Each converged state is factorised once more (that factorisation also gives the next
+predictor, so it replaces one the next step would make) and a change of the count flags a
+limit or bifurcation point (:mod:`beamfx.solvers.bifurcation`): bifurcations are located, and
+with ``branch = "secondary"`` the trace leaves the primary path at the first one.
+
 References:
     M. A. Crisfield, "A fast incremental/iterative solution procedure that handles
     snap-through", Computers & Structures 13 (1981) 55–62.
@@ -49,7 +56,9 @@ from typing import NamedTuple
 import numpy as np
 
 from .assembly import assemble_load, assemble_residual, assemble_tangent
+from .bifurcation import CriticalPoint, classify, locate, smallest_eigenpair
 from .forms import compile_form
+from .inertia import InertiaCounter, counts_inertia, negative_pivots, prepare
 from .options import petsc_options
 from .snes import SolveFailed
 
@@ -77,6 +86,15 @@ class ArcLengthSettings:
         desired_iterations: I_d of the step-size rule Δl_new = Δl (I_d / I)^½.
         max_growth: bound on Δl_new / Δl after a converged step.
         min_arc_length, max_arc_length: bounds on Δl, as multiples of the first arc length.
+        bounds: (smallest, largest) Δl in the units of the measured dofs; an entry given
+            replaces the relative bound.
+        inertia: count the negative eigenvalues of the tangent at every converged state
+            (symmetric tangents only: ignored for follower loads).
+        branch: "primary" (locate bifurcations, go on along the path) or "secondary" (switch
+            onto the secondary branch at the first bifurcation).
+        switch_amplitude: arc length of the first step onto the secondary branch (None: the
+            arc length of the step that passed the bifurcation).
+        locate_tol: bifurcations are located to this fraction of the step's arc length.
     """
 
     method: str = "crisfield"
@@ -91,6 +109,11 @@ class ArcLengthSettings:
     max_growth: float = 2.0
     min_arc_length: float = 1e-4
     max_arc_length: float = 10.0
+    bounds: tuple = (None, None)
+    inertia: bool = True
+    branch: str = "primary"
+    switch_amplitude: float | None = None
+    locate_tol: float = 1e-7
 
 
 class ArcLengthStep(NamedTuple):
@@ -102,6 +125,8 @@ class ArcLengthStep(NamedTuple):
     iterations: int  # corrector iterations (one factorisation each)
     residuals: tuple  # ‖R‖ before each corrector iteration and at convergence
     cutbacks: int  # failed attempts before this step converged
+    negative_eigenvalues: int | None = None  # of the tangent at the new point (None: not counted)
+    note: str = ""  # "bifurcation point" (located), "branch switch" (first secondary step)
 
 
 class ArcLengthResult(NamedTuple):
@@ -109,11 +134,28 @@ class ArcLengthResult(NamedTuple):
 
     steps: tuple  # accepted ArcLengthStep records
     reason: str  # "target", "stop", "max_steps"
-    seconds: dict  # wall time split: assemble_F, assemble_J, solve, total
+    seconds: dict  # wall time split: assemble_F, assemble_J, solve, inertia, locate, total
+    critical_points: tuple = ()  # CriticalPoint records, in path order
+    negative_eigenvalues: int | None = None  # at the starting state
 
 
 class _StepFailed(Exception):
     pass
+
+
+@dataclass
+class _Path:
+    """Where a trace is: the last accepted state and what the next step needs."""
+
+    lam: float
+    direction: object  # (Δw, Δλ) of the last step, or the sign of the first one
+    count: int | None  # negative eigenvalues of K at the last state
+    forward: float  # the predictor's load direction ±1 there
+    control: object  # StepControl of Δl
+    steps: list
+    critical: list
+    tried: list  # (Δl, why, residuals) of the failed attempts at the next step
+    switched: bool = False
 
 
 class ArcLengthSolver:
@@ -141,6 +183,10 @@ class ArcLengthSolver:
         self.settings = settings or ArcLengthSettings()
         if self.settings.method not in ("crisfield", "riks"):
             raise ValueError(f"method must be 'crisfield' or 'riks', got {self.settings.method!r}")
+        if self.settings.branch not in ("primary", "secondary"):
+            raise ValueError(
+                f"branch must be 'primary' or 'secondary', got {self.settings.branch!r}"
+            )
         self.w, self.lam, self.bcs = w, load_factor, bcs
         self.F = F if hasattr(F, "ufcx_form") else compile_form(F)
         self.J = J if hasattr(J, "ufcx_form") else compile_form(J)
@@ -149,6 +195,9 @@ class ArcLengthSolver:
         self.R, self.f = fp.create_vector(self.F), fp.create_vector(self.F)
         self.dw_R, self.dw_f = self.R.duplicate(), self.R.duplicate()
         self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0}
+        self.seconds.update(inertia=0.0, locate=0.0)
+        self.counting = self.settings.inertia and not self.settings.follower
+        self._cached, self._prepared = None, False
 
         n_owned = (
             w.function_space.dofmap.index_map.size_local * w.function_space.dofmap.index_map_bs
@@ -161,10 +210,15 @@ class ArcLengthSolver:
 
         ksp = PETSc.KSP().create(self.comm)
         ksp.setOptionsPrefix(prefix)
-        self.options = {**DEFAULT_OPTIONS, **(options or {})}
+        # a symmetric tangent: LDLᵀ, half the work of LU, and its pivots give the inertia
+        base = {**DEFAULT_OPTIONS, **({"pc_type": "cholesky"} if self.counting else {})}
+        self.options = {**base, **(options or {})}
         with petsc_options(prefix, self.options):
             ksp.setFromOptions()
         self.ksp = ksp
+        self._counter = None
+        if self.counting and not counts_inertia(ksp):
+            self._counter = InertiaCounter(self.comm, prefix + "inertia_")
 
     # --- assembly and linear algebra -------------------------------------------------------
 
@@ -194,6 +248,9 @@ class ArcLengthSolver:
         t = time.perf_counter()
         try:
             self.ksp.setOperators(self.A)
+            if not self._prepared:
+                prepare(self.ksp)
+                self._prepared = True
             self.ksp.setUp()
         except PETSc.Error as e:
             raise _StepFailed(f"factorisation failed (PETSc error {e.ierr})") from None
@@ -227,14 +284,44 @@ class ArcLengthSolver:
     # --- one step --------------------------------------------------------------------------
 
     def _tangent(self, lam):
-        """δw_f = K⁻¹ f at the current point."""
+        """δw_f = K⁻¹ f at the current point (the one :meth:`_at_state` left, if any)."""
+        if self._cached is not None:
+            t, self._cached = self._cached, None
+            return t
         self._factor(lam)
         if self.settings.follower:
             self._load()
         self._solve(self.f, self.dw_f)
         return self.dw_f.copy()
 
-    def _step(self, lam_n, dl, direction, land_at=None):
+    def _forward(self, direction, t):
+        """The predictor's load direction ±1 along δw_f = ``t``: forward from the previous
+        increment ``direction = (Δw, Δλ)``, or the sign ``direction`` itself."""
+        if not isinstance(direction, tuple):
+            return direction
+        dw, dlam = direction
+        return math.copysign(1.0, self._dot(dw, t) + self.settings.psi**2 * dlam * self.ff)
+
+    def _predict(self, lam_n, dl, direction, land_at=None, inject=None):
+        """The predictor (Δw_0, Δλ_0) of a step (see :meth:`_step`)."""
+        s, ff = self.settings, self.ff
+        if inject is not None:
+            dw = inject.copy()
+            dw.scale(dl / math.sqrt(self._dot(dw, dw)))
+            return dw, 0.0
+        if land_at is not None:
+            dw, dlam = direction[0].copy(), direction[1]
+            dw.scale((land_at - lam_n) / dlam)
+            return dw, land_at - lam_n
+        t = self._tangent(lam_n)
+        a = math.sqrt(self._dot(t, t) + s.psi**2 * ff)
+        if a == 0:
+            raise _StepFailed("the load moves no measured dof (δw_f^T S δw_f = 0, ψ = 0)")
+        dlam = self._forward(direction, t) * dl / a
+        t.scale(dlam)
+        return t, dlam
+
+    def _step(self, lam_n, dl, direction, land_at=None, inject=None):
         """Corrector iterations of one step from the current (converged) state (w_n, λ_n).
 
         Args:
@@ -243,27 +330,14 @@ class ArcLengthSolver:
             direction: (Δw_prev, Δλ_prev) of the previous step, or the sign of the first one.
             land_at: solve at this fixed load factor instead (δλ = 0), from the predictor
                 ``direction = (Δw, Δλ)`` scaled onto it.
+            inject: predictor Δw = ξ·inject with Δλ = 0, scaled to the arc length ``dl``
+                (mode injection onto a secondary branch).
 
         Returns:
             (Δw, Δλ, iterations, residuals); w and λ hold the new point.
         """
-        s, ff = self.settings, self.ff
-        if land_at is None:
-            t = self._tangent(lam_n)
-            a = math.sqrt(self._dot(t, t) + s.psi**2 * ff)
-            if a == 0:
-                raise _StepFailed("the load moves no measured dof (δw_f^T S δw_f = 0, ψ = 0)")
-            if isinstance(direction, tuple):
-                sign = math.copysign(1.0, self._dot(direction[0], t) + s.psi**2 * direction[1] * ff)
-            else:
-                sign = direction
-            dlam = sign * dl / a
-            dw = t
-            dw.scale(dlam)
-        else:
-            dw, dlam = direction[0].copy(), direction[1]
-            dw.scale((land_at - lam_n) / dlam)
-            dlam = land_at - lam_n
+        s = self.settings
+        dw, dlam = self._predict(lam_n, dl, direction, land_at, inject)
         dw0, dlam0 = dw.copy(), dlam
         self._add(dw)
 
@@ -353,81 +427,258 @@ class ArcLengthSolver:
             :class:`ArcLengthResult`.
 
         Raises:
-            SolveFailed: when Δl falls below ``min_arc_length`` times the first Δl; names the
-                step, the last converged λ and the residual history of every attempt.
+            SolveFailed: when Δl falls below its smallest value; names the step, the last
+                converged λ and the residual history of every attempt.
         """
         t_start = time.perf_counter()
-        s = self.settings
         lam = float(self.lam.value)
         self._load()
         self.f_norm = math.sqrt(self.ff)
         if self.f_norm == 0:
             raise ValueError("the load vector is zero: F does not depend on the load factor")
-        if arc_length is None:
-            t = self._tangent(lam)
-            arc_length = abs(first_load_increment) * math.sqrt(self._dot(t, t) + s.psi**2 * self.ff)
-            t.destroy()
         sign = math.copysign(1.0, first_load_increment)
         if target_load_factor is not None and target_load_factor != lam:
             sign = math.copysign(1.0, target_load_factor - lam)
-        from .step_control import IterationRatio, StepControl, StepTooSmall
-
-        dl0 = float(arc_length)
-        growth = IterationRatio(s.desired_iterations, 0.5, s.max_growth)
-        control = StepControl(dl0, s.max_arc_length * dl0, s.min_arc_length * dl0, growth)
-        direction, steps, tried = sign, [], []
+        count, forward = self._at_state(lam, sign)
+        if arc_length is None:
+            t = self._cached
+            a = math.sqrt(self._dot(t, t) + self.settings.psi**2 * self.ff)
+            arc_length = abs(first_load_increment) * a
+        path = _Path(lam, sign, count, forward, self._control(arc_length), [], [], [])
         saved = self.w.vector.copy()
         reason = "max_steps"
-        while len(steps) < max_steps:
+        while len(path.steps) < max_steps:
             self.w.vector.copy(saved)
-            dl = control.size
-            try:
-                dw, dlam, its, res = self._step(lam, dl, direction)
-            except _StepFailed as e:
-                self._restore(saved, lam)
-                tried.append((dl, e.args[0], e.args[1] if len(e.args) > 1 else ()))
-                if log:
-                    log(
-                        f"step {len(steps) + 1}: arc length {dl:.4g} failed ({e.args[0]}); halving it"
-                    )
-                try:
-                    control.rejected()
-                except StepTooSmall:
-                    raise SolveFailed(self._failure(len(steps) + 1, lam, tried), steps) from None
+            taken = self._attempt(path, saved, log)
+            if taken is None:
                 continue
+            dw, dlam, its, res = taken
             reached = target_load_factor is not None and (
-                (lam - target_load_factor) * (lam + dlam - target_load_factor) < 0
-                or lam + dlam == target_load_factor
+                (path.lam - target_load_factor) * (path.lam + dlam - target_load_factor) < 0
+                or path.lam + dlam == target_load_factor
             )
-            if reached and lam + dlam != target_load_factor:
-                landed = self._land(saved, lam, dw, dlam, target_load_factor)
+            if reached and path.lam + dlam != target_load_factor:
+                landed = self._land(saved, path.lam, dw, dlam, target_load_factor)
                 if landed:
                     dw, dlam, its, res = landed
-            length = math.sqrt(self._dot(dw, dw) + s.psi**2 * dlam**2 * self.ff)
-            step = ArcLengthStep(len(steps) + 1, lam + dlam, length, its, res, len(tried))
-            steps.append(step)
-            lam, tried = lam + dlam, []
-            if log:
-                log(
-                    f"step {step.step}: load factor {lam:.6g}, arc length {length:.4g}, "
-                    f"{its} iterations, |R| {res[-1]:.3e}"
-                )
-            if on_step:
-                on_step(step)
-            if isinstance(direction, tuple):
-                direction[0].destroy()
-            direction = (dw, dlam)
+            if self._accept(path, saved, (dw, dlam, its, res), on_step, log):
+                reached = False  # switched onto another branch before the step's end
             if reached:
                 reason = "target"
                 break
-            if stop is not None and stop(step):
+            if stop is not None and stop(path.steps[-1]):
                 reason = "stop"
                 break
-            control.accepted(its)
+            path.control.accepted(its)
         saved.destroy()
-        self.lam.value = lam
+        self.lam.value = path.lam
         seconds = {**self.seconds, "total": time.perf_counter() - t_start}
-        return ArcLengthResult(tuple(steps), reason, seconds)
+        return ArcLengthResult(tuple(path.steps), reason, seconds, tuple(path.critical), count)
+
+    def _control(self, dl0):
+        """The step controller of Δl from the first arc length ``dl0``."""
+        from .step_control import IterationRatio, StepControl
+
+        s = self.settings
+        smallest, largest = s.bounds
+        smallest = s.min_arc_length * dl0 if smallest is None else smallest
+        largest = s.max_arc_length * dl0 if largest is None else largest
+        growth = IterationRatio(s.desired_iterations, 0.5, s.max_growth)
+        return StepControl(min(max(dl0, smallest), largest), largest, smallest, growth)
+
+    def _attempt(self, path, saved, log):
+        """One try of the next step: (Δw, Δλ, iterations, residuals), or None after a failure
+        (state restored, Δl halved). Raises SolveFailed when Δl gets too small."""
+        from .step_control import StepTooSmall
+
+        dl = path.control.size
+        try:
+            return self._step(path.lam, dl, path.direction)
+        except _StepFailed as e:
+            self._restore(saved, path.lam)
+            path.tried.append((dl, e.args[0], e.args[1] if len(e.args) > 1 else ()))
+            if log:
+                n = len(path.steps) + 1
+                log(f"step {n}: arc length {dl:.4g} failed ({e.args[0]}); halving it")
+            try:
+                path.control.rejected()
+            except StepTooSmall:
+                failure = self._failure(len(path.steps) + 1, path.lam, path.tried)
+                raise SolveFailed(failure, path.steps) from None
+            return None
+
+    def _accept(self, path, saved, taken, on_step, log):
+        """Record the converged step ``taken`` from the state ``saved``; its inertia, and the
+        critical point it passed (located, and the branch switched, for a bifurcation).
+        Returns whether the path switched branch (it no longer ends where the step did)."""
+        dw, dlam, its, res = taken
+        lam = path.lam + dlam
+        count, forward = self._at_state(lam, (dw, dlam))
+        kind = classify(path.count, count, path.forward, forward)
+        if kind is not None:
+            point = CriticalPoint(kind, len(path.steps) + 1, (path.lam, lam), path.count, count)
+            if log:
+                log(
+                    f"step {point.step}: {kind} point passed between load factors "
+                    f"{path.lam:.6g} and {lam:.6g} (negative eigenvalues {path.count} -> {count})"
+                )
+            if kind == "bifurcation":
+                switch = self.settings.branch == "secondary" and not path.switched
+                if self._bifurcation(path, saved, taken, point, switch, on_step, log):
+                    return True
+            else:
+                path.critical.append(point)
+        length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        self._record(path, (dw, dlam, its, res), length, count, forward, on_step, log)
+        return False
+
+    def _record(self, path, taken, length, count, forward, on_step, log, note=""):
+        """Append the step ``taken`` (its end is the current state) and move the path on."""
+        dw, dlam, its, res = taken
+        steps = path.steps
+        step = ArcLengthStep(
+            len(steps) + 1, path.lam + dlam, length, its, res, len(path.tried), count, note
+        )
+        steps.append(step)
+        if log:
+            inertia = "" if count is None else f", {count} negative eigenvalues"
+            log(
+                f"step {step.step}: load factor {step.load_factor:.6g}, arc length "
+                f"{length:.4g}, {its} iterations, |R| {res[-1] if res else 0:.3e}{inertia}"
+                + (f" ({note})" if note else "")
+            )
+        if on_step:
+            on_step(step)
+        if isinstance(path.direction, tuple):
+            path.direction[0].destroy()
+        path.lam, path.direction, path.tried = step.load_factor, (dw, dlam), []
+        if count is not None:
+            path.count, path.forward = count, forward
+
+    # --- stability -------------------------------------------------------------------------
+
+    def _at_state(self, lam, direction):
+        """Factorise K at the converged state and keep δw_f = K⁻¹f for the next predictor.
+
+        Returns:
+            (negative eigenvalues of K or None, the predictor's load direction ±1 there).
+        """
+        self._factor(lam)
+        if self.settings.follower:
+            self._load()
+        self._solve(self.f, self.dw_f)
+        if self._cached is not None:
+            self._cached.destroy()
+        self._cached = self.dw_f.copy()
+        return self._count(), self._forward(direction, self._cached)
+
+    def _count(self):
+        """Negative eigenvalues of the factorised K (None when not counted)."""
+        if not self.counting:
+            return None
+        t = time.perf_counter()
+        n = negative_pivots(self.ksp) if self._counter is None else self._counter.count(self.A)
+        self.seconds["inertia"] += time.perf_counter() - t
+        return n
+
+    def _bifurcation(self, path, saved, taken, point, switch, on_step, log):
+        """Locate the bifurcation the step ``taken`` passed; with ``switch``, record the
+        located point and a first step along the secondary branch and return True; else
+        note the point, put the state back at the step's end and return False."""
+        dw, dlam = taken[:2]
+        t = time.perf_counter()
+        end, lam_end, cached = self.w.vector.copy(), path.lam + dlam, self._cached
+        self._cached = None
+        dl = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        try:
+            x, lam_c, mu, n, phi = self._locate(path, saved, (end, lam_end, dl), point)
+        except _StepFailed as e:
+            x = None
+            if log:
+                log(f"  the bifurcation could not be located ({e.args[0]})")
+        self.seconds["locate"] += time.perf_counter() - t
+        if x is not None:
+            point = point._replace(load_factor=lam_c, eigenvalue=mu, probes=n)
+            if log:
+                log(f"  bifurcation located at load factor {lam_c:.8g} ({n} solves)")
+        if x is None or not switch:
+            path.critical.append(point)
+            self._restore(end, lam_end)
+            self._cached = cached
+            end.destroy()
+            return False
+        cached.destroy()
+        end.destroy()
+        path.critical.append(point._replace(switched=True))
+        path.switched = True
+        dw.destroy()
+        dw_c = self.w.vector.copy()  # the located point, from the step's start
+        dw_c.axpy(-1.0, saved)
+        located = (dw_c, lam_c - path.lam, 0, ())
+        self._record(path, located, x, None, path.forward, on_step, log, "bifurcation point")
+        self._switch(path, phi, dl, on_step, log)
+        return True
+
+    def _locate(self, path, saved, end, point):
+        """Find the bifurcation within the last step (module :mod:`.bifurcation`): returns
+        (arc length from the step's start, λ, eigenvalue, solves, null vector); w and λ
+        are left at the located point."""
+        from mpi4py import MPI
+
+        end_vec, lam_end, dl = end
+        phi = self.R.duplicate()
+        rng = np.random.default_rng(self.comm.rank)
+        phi.setArray(rng.standard_normal(phi.getLocalSize()))
+        last = {}
+
+        def probe(x):
+            if x == dl:
+                self._restore(end_vec, lam_end)
+                lam = lam_end
+            else:
+                self._restore(saved, path.lam)
+                lam = path.lam + (self._step(path.lam, x, path.direction)[1] if x else 0.0)
+            self._factor(lam)
+            count = self._count()
+            mu, _ = smallest_eigenpair(self.A, self._solve, phi)
+            last.update(lam=lam, mu=mu)
+            return count, mu
+
+        x, n = locate(probe, dl, point.negative_before, self.settings.locate_tol)
+        # the sign of the mode: its largest measured component positive (same on any ranks)
+        a = phi.getArray(readonly=True)[self.norm_dofs]
+        top = self.comm.allreduce(float(a.max(initial=-np.inf)), op=MPI.MAX)
+        bottom = self.comm.allreduce(float(a.min(initial=np.inf)), op=MPI.MIN)
+        if -bottom > top:
+            phi.scale(-1.0)
+        return x, last["lam"], last["mu"], n, phi
+
+    def _switch(self, path, phi, dl, on_step, log):
+        """Mode injection from the located point: the first step along φ, Δλ = 0 predicted,
+        of arc length ``switch_amplitude`` (default ``dl``), halved up to 4 times."""
+        amplitude = self.settings.switch_amplitude or dl
+        start, lam_c = self.w.vector.copy(), path.lam
+        for _ in range(5):
+            try:
+                taken = self._step(lam_c, amplitude, None, inject=phi)
+                break
+            except _StepFailed as e:
+                self._restore(start, lam_c)
+                if log:
+                    log(f"  branch switch with amplitude {amplitude:.4g} failed ({e.args[0]})")
+                amplitude /= 2
+        else:
+            raise SolveFailed(
+                f"branch switching at load factor {lam_c:.6g} failed: the step along the "
+                "null vector did not converge (try another switch_amplitude)",
+                path.steps,
+            )
+        start.destroy()
+        phi.destroy()
+        dw, dlam = taken[:2]
+        count, forward = self._at_state(lam_c + dlam, (dw, dlam))
+        length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        self._record(path, taken, length, count, forward, on_step, log, note="branch switch")
 
     def _land(self, saved, lam, dw, dlam, target):
         """Redo the step that crossed ``target`` at fixed λ = target; None if that fails."""
@@ -465,3 +716,7 @@ class ArcLengthSolver:
         """Free the solver's PETSc objects."""
         for obj in (self.ksp, self.A, self.R, self.f, self.dw_R, self.dw_f):
             obj.destroy()
+        if self._counter is not None:
+            self._counter.destroy()
+        if self._cached is not None:
+            self._cached.destroy()

@@ -25,7 +25,6 @@ KNOWN = {
         "beamfx/analyses/transient.py::solve_transient",
         "beamfx/bench/adaptive_bend45.py::AdaptiveCase.run_setting",
         "beamfx/bench/solid_scaling.py::report",
-        "beamfx/solvers/arclength.py::ArcLengthSolver.trace",
     ],
 }
 
