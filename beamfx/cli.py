@@ -64,8 +64,16 @@ def _run(args):
     if "members" not in results:  # one scene: results.json says how it ended
         if results.converged:
             return 0
-        print(f"beamfx: {results.result.status}: {results.result.reason}", file=sys.stderr)
-        return 3
+        from mpi4py import MPI
+
+        from .interrupt import received
+
+        if MPI.COMM_WORLD.rank == 0:
+            more = "; go on with 'beamfx run --restart'" if received() else ""
+            print(
+                f"beamfx: {results.result.status}: {results.result.reason}{more}", file=sys.stderr
+            )
+        return 128 + received() if received() else 3
     failed = [m["member"] for m in results["members"] if m["status"] != "converged"]
     if failed:  # a sweep: the table is written, but say that it has holes
         print(f"beamfx: sweep members {failed} failed (see sweep.md)", file=sys.stderr)
@@ -129,22 +137,43 @@ COMMANDS = {"run": _run, "check": _check, "solid": _solid, "bench": _bench, "war
 
 
 def main(argv=None):
-    """``beamfx <command>``: 0 on success, 2 on bad input, 3 on a failed solve."""
+    """``beamfx <command>``: 0 on success, 2 on bad input, 3 on a failed solve, 130/143 when
+    interrupted by SIGINT/SIGTERM. Under MPI a failure on any rank ends every rank
+    (:func:`beamfx.interrupt.stop_everywhere`): never a hang."""
+    from .interrupt import error_comm, handle_signals, stop_everywhere
+
     args = _parser().parse_args(argv)
+    errors = error_comm()
+    with handle_signals():
+        code, message = _guarded(args, errors is not None)
+    if message is not None:
+        code = stop_everywhere(message, code, errors)
+    if errors is not None:
+        errors.Free()
+    return code
+
+
+def _guarded(args, parallel):
+    """(exit status, message or None) of the command: errors become one line; a traceback
+    only for a bug in a serial run (under MPI it is printed and every rank stops)."""
+    from .interrupt import Interrupted
     from .scene import SceneError
+    from .solvers import SolveFailed
 
     try:
-        return COMMANDS[args.command](args)
+        return COMMANDS[args.command](args), None
+    except Interrupted as e:
+        return e.exit_code, f"beamfx: {e}"
     except (SceneError, ValueError, OSError) as e:
-        print(f"beamfx: error: {e}", file=sys.stderr)
-        return 2
-    except Exception as e:  # a failed solve: report it plainly, no traceback soup
-        from .solvers import SolveFailed
+        return 2, f"beamfx: error: {e}"
+    except SolveFailed as e:
+        return 3, f"beamfx: solve failed: {e}"
+    except Exception:
+        if not parallel:
+            raise
+        import traceback
 
-        if isinstance(e, SolveFailed):
-            print(f"beamfx: solve failed: {e}", file=sys.stderr)
-            return 3
-        raise
+        return 1, "beamfx: internal error:\n" + traceback.format_exc()
 
 
 if __name__ == "__main__":

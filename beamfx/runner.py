@@ -88,6 +88,7 @@ def run_scene(
 
     from .analyses.registry import analysis
     from .io import log as default_log
+    from .io.folder import claim
 
     comm = comm or MPI.COMM_WORLD
     log = log or partial(default_log, comm=comm)
@@ -103,36 +104,38 @@ def run_scene(
             return run_sweep(scene, out_dir, run_scene, log=log, png=png, comm=comm)
     out = _prepare(Path(out_dir or scene.output_dir), scene, comm, out_dir is None)
     log(f"beamfx: {path} -> {out}/")
-    scene, refinement = _refine(scene, comm, log)
-    ctx = _context(scene, out, comm, log, restart, png or animate)
-    result = analysis(scene.analysis).run(ctx.model, scene.settings, ctx)
-    ctx.frames.close()
-    run = RunResult(
-        str(path),
-        result,
-        _model_entry(scene, ctx),
-        _final_probes(scene, ctx),
-        {**result.seconds, "run": time.perf_counter() - t_start},
-        ctx.frames.files(),
-        refinement.entry(scene.accuracy) if refinement else None,
-    )
-    return _finish(run, out, scene, refinement, log, comm, png, animate)
+    with claim(out, comm, path, restart, log):  # locked, an earlier run's files removed
+        scene, refinement = _refine(scene, comm, log)
+        ctx = _context(scene, out, comm, log, restart, png or animate)
+        result = analysis(scene.analysis).run(ctx.model, scene.settings, ctx)
+        ctx.frames.close()
+        run = RunResult(
+            str(path),
+            result,
+            _model_entry(scene, ctx),
+            _final_probes(scene, ctx),
+            {**result.seconds, "run": time.perf_counter() - t_start},
+            ctx.frames.files(),
+            refinement.entry(scene.accuracy) if refinement else None,
+        )
+        return _finish(run, out, scene, refinement, log, comm, png, animate)
 
 
 def _prepare(out, scene, comm, named_by_scene):
-    """The output folder, checked writable, without a stale results.json; the frame writers'
-    library imported (VTK before DOLFINx) or its absence reported, before any model is built.
-    ``named_by_scene``: the folder is the scene's ``[output] dir`` (named in the error)."""
+    """The output folder, allowed (:func:`beamfx.io.folder.check_output_dir`) and checked
+    writable; the frame writers' library imported (VTK before DOLFINx) or its absence
+    reported, before any model is built. ``named_by_scene``: the folder is the scene's
+    ``[output] dir`` (named in the error)."""
     from .io import check_writable
+    from .io.folder import check_output_dir
     from .io.output import prepare_output
 
+    check_output_dir(out, scene.file if named_by_scene else None)
     try:
         check_writable(out, comm)
     except OSError as e:
         raise OSError(f"{scene.file}: output.dir: {e}" if named_by_scene else str(e)) from None
     prepare_output(scene.output)
-    if comm.rank == 0 and (out / "results.json").exists():
-        os.remove(out / "results.json")
     return out
 
 
@@ -265,9 +268,11 @@ def check_scene(path: str | os.PathLike) -> "Scene | Sweep":
     """Validate a scene without solving: keys, types, points, supports; for a sweep file every
     member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
     from .analyses.checks import check_supports_for
+    from .io.folder import check_output_dir
     from .scene import Sweep, load_scene_or_sweep
 
     loaded = load_scene_or_sweep(path)
     for scene in [m.scene for m in loaded.members] if isinstance(loaded, Sweep) else [loaded]:
         check_supports_for(scene.model, scene.settings)
+    check_output_dir(loaded.output_dir, str(path))
     return loaded

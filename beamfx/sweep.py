@@ -78,10 +78,12 @@ def run_sweep(sweep, out_dir, run_scene, log=None, comm=None, **options):
 
     from .io import check_writable, write_json_atomic
     from .io import log as default_log
+    from .io.folder import check_output_dir
 
     comm = comm or MPI.COMM_WORLD
     log = log or partial(default_log, comm=comm)
     out = Path(out_dir or sweep.output_dir)
+    check_output_dir(out, sweep.file if out_dir is None else None)
     check_writable(out, comm)
     jsonl = out / "sweep.jsonl"
     if comm.rank == 0 and jsonl.exists():

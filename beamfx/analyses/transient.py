@@ -19,7 +19,6 @@ dissipation; what is left is the integrator's numerical dissipation.
 
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -363,32 +362,72 @@ class EnergyBalance:
         )
 
 
-def _checkpoint_path(folder, comm):
-    return Path(folder) / f"checkpoint_{comm.size}ranks_{comm.rank}.npz"
+def control_state(control):
+    """The step controller's state: the next step size and the growth policy's counters."""
+    from dataclasses import fields
+
+    growth = control.growth
+    private = {f.name: getattr(growth, f.name) for f in fields(growth) if f.name.startswith("_")}
+    return {"size": float(control.size), "growth": type(growth).__name__, "state": private}
 
 
-def save_checkpoint(folder, dyn, balance, t, h, step):
-    """The state needed to go on from t (written atomically, one file per rank)."""
-    import pickle
-
-    path = _checkpoint_path(folder, dyn.model.comm)
-    tmp = path.with_suffix(".tmp.npz")
-    extra = pickle.dumps({"t": t, "h": h, "step": step, "balance": balance.get()})
-    np.savez(tmp, extra=np.frombuffer(extra, np.uint8), **dyn.state())
-    tmp.replace(path)
+def restore_control(control, state):
+    """Put a saved :func:`control_state` back into ``control`` (same policy)."""
+    control.size = float(state["size"])
+    if state.get("growth") == type(control.growth).__name__:
+        for k, v in state.get("state", {}).items():
+            if k.startswith("_") and hasattr(control.growth, k):
+                setattr(control.growth, k, v)
 
 
-def load_checkpoint(folder, comm):
-    """The saved state, or None if there is no checkpoint for this number of ranks."""
-    import pickle
+def checkpoint_state(dyn, balance, control, t, step):
+    """(header, arrays) of the state to go on from ``t``: the state at t_n, the energy
+    balance, the step controller (see :mod:`beamfx.io.checkpoint` for the file)."""
+    arrays = dyn.state()
+    previous = balance.previous or {}
+    saved = {"values": dict(balance.values), "initial": balance.initial}
+    saved["power"] = previous.get("power")
+    for key in ("loads", "reaction"):
+        value = previous.get(key)
+        if isinstance(value, np.ndarray):
+            arrays[f"balance_{key}"], value = value, "array"
+        saved[key] = value
+    header = {"t": float(t), "step": int(step), "size": float(control.size)}
+    return {**header, "controller": control_state(control), "balance": saved}, arrays
 
-    path = _checkpoint_path(folder, comm)
-    if not path.exists():
-        return None
-    data = np.load(path)
-    out = {k: data[k] for k in ("q_n", "v_n", "a_n", "qdd_n")}
-    out.update(pickle.loads(data["extra"].tobytes()))
-    return out
+
+def restore_state(saved, dyn, balance, control):
+    """Put a checkpoint's (header, arrays) back: state, energy balance and step controller;
+    returns (t, step)."""
+    header, arrays = saved
+    dyn.set_state({k: arrays[k] for k in ("q_n", "v_n", "a_n", "qdd_n")})
+    b = header["balance"]
+    previous = None
+    if b["power"] is not None:
+        previous = {"power": b["power"]}
+        for key in ("loads", "reaction"):
+            value = b.get(key)
+            previous[key] = arrays[f"balance_{key}"] if value == "array" else (value or 0.0)
+    balance.set({"values": b["values"], "initial": b["initial"], "previous": previous})
+    restore_control(control, header["controller"])
+    return header["t"], header["step"]
+
+
+def _begin(saved, dyn, balance, control, on_step, log):
+    """(t, step) to march from: the checkpoint ``saved``, else t = 0 at rest (recorded)."""
+    model = dyn.model
+    if saved is not None:
+        t, step = restore_state(saved, dyn, balance, control)
+        model.set_time(t)
+        log(f"restart from the checkpoint at t = {t:.6g} (step {step})")
+        return t, step
+    model.set_time(0.0)
+    dyn.start()
+    balance.reactions()
+    record = StepRecord(0, 0.0, 0.0, 0, (), 0, balance.record(None, 0.0))
+    if on_step:
+        on_step(record)
+    return 0.0, 0
 
 
 def solve_transient(
@@ -398,7 +437,7 @@ def solve_transient(
     log=None,
     progress=None,
     options=None,
-    checkpoint_dir=None,
+    checkpoint=None,
     saved=None,
     prefix="beamfx_transient_",
 ):
@@ -408,18 +447,21 @@ def solve_transient(
     the step size down to ``dt_min``; after ``easy_iterations`` or fewer the step grows by 1.5
     up to ``dt``; with ``settings.tolerance`` the local error estimate
     (:meth:`Dynamics.error_estimate`) rejects and sizes the steps instead.
-    ``on_step(record)`` is called after every accepted step (and at t = 0 with step 0), so output is written as the run goes; checkpoints every ``checkpoint_every``
-    steps let a later call go on from the last one: pass it as ``saved``
-    (:func:`load_checkpoint`).
+    ``on_step(record)`` is called after every accepted step (and at t = 0 with step 0), so
+    output is written as the run goes. ``checkpoint(header, arrays)`` is called every
+    ``checkpoint_every`` steps, at the end, before a failure is raised and when the march is
+    interrupted (:mod:`beamfx.interrupt`: a SIGINT or SIGTERM stops it at an accepted step,
+    ``stopped_by`` then names the signal), with :func:`checkpoint_state`; pass such a state as
+    ``saved`` to go on from it.
 
     Raises:
         TransientFailed: naming the time, the step size and the residual history, after the
-            last good state was checkpointed (when ``checkpoint_dir`` is set).
+            last good state was checkpointed.
     """
-    t_start = time.perf_counter()
+    from ..interrupt import pending, reason
     from ..solvers.forms import compile_seconds
 
-    c0 = compile_seconds[0]
+    t_start, c0 = time.perf_counter(), compile_seconds[0]
     s = settings
     dyn = Dynamics(model, s)
     solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
@@ -430,32 +472,22 @@ def solve_transient(
     dt_min = s.dt_min or s.dt / 1000
     length = model_size(model.spec)  # the scale of the displacements
     log = log or (lambda msg: None)
+    growth = ErrorBased() if s.tolerance else EasyGrowth(1.5, s.easy_iterations, 2, clean=True)
+    control = StepControl(s.dt, s.dt, dt_min, growth)
+
+    def save(t, step):
+        if checkpoint:
+            checkpoint(*checkpoint_state(dyn, balance, control, t, step))
 
     model.set_load_factor(1.0)
-    if saved is not None:
-        dyn.set_state({k: saved[k] for k in ("q_n", "v_n", "a_n", "qdd_n")})
-        t, h, step = saved["t"], saved["h"], saved["step"]
-        balance.set(saved["balance"])
-        model.set_time(t)
-        log(f"restart from the checkpoint at t = {t:.6g} (step {step})")
-        if projection:
-            projection.remember()
-    else:
-        t, h, step = 0.0, s.dt, 0
-        model.set_time(0.0)
-        dyn.start()
-        if projection:
-            projection.remember()
-        balance.reactions()
-        record = StepRecord(0, 0.0, 0.0, 0, (), 0, balance.record(None, 0.0))
-        if on_step:
-            on_step(record)
-    records, iterations, error = [], 0, None
-    growth = ErrorBased() if s.tolerance else EasyGrowth(1.5, s.easy_iterations, 2, clean=True)
-    control = StepControl(h, s.dt, dt_min, growth)
+    t, step = _begin(saved, dyn, balance, control, on_step, log)
+    if projection:
+        projection.remember()
+    records, iterations, error, stopped_by = [], 0, None, "t_end"
     q_old = model.w.x.array.copy()
     while t < s.t_end * (1 - 1e-12):
-        h = control.size = min(control.size, s.t_end - t)
+        wanted = control.size  # kept if only the end time shortens this step
+        h = control.size = min(wanted, s.t_end - t)
         cutbacks, tried = 0, []
         while True:
             dyn.h.value = h
@@ -466,8 +498,8 @@ def solve_transient(
                 error = dyn.error_estimate(h, s.tolerance, length)
                 if error <= 1.0 or h <= dt_min * (1 + 1e-9):
                     break
-                reason = f"local error {error:.3g} x tolerance"
-                tried.append((h, reason, report.residuals))
+                reason_ = f"local error {error:.3g} x tolerance"
+                tried.append((h, reason_, report.residuals))
                 model.w.x.array[:] = dyn.q_n.x.array
                 h, cutbacks = control.rejected(error), cutbacks + 1
                 continue
@@ -479,25 +511,15 @@ def solve_transient(
             try:
                 h = control.rejected()
             except StepTooSmall:
-                if checkpoint_dir:
-                    save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
-                lines = [
-                    f"  dt = {dt:.3g}: {reason}, residuals {', '.join(f'{r:.3e}' for r in res)}"
-                    for dt, reason, res in tried
-                ]
-                raise TransientFailed(
-                    f"time step from t = {t:.6g} failed at every step size down to "
-                    f"dt_min = {dt_min:.3g}:\n" + "\n".join(lines)
-                ) from None
+                save(t, step)
+                raise TransientFailed(_failure(t, dt_min, tried)) from None
             log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
         q_old[:] = dyn.q_n.x.array
         balance.reactions()
         dyn.accept(h)
         if projection:
             projection.apply(t, t + h)
-        t += h
-        step += 1
-        iterations += report.iterations
+        t, step, iterations = t + h, step + 1, iterations + report.iterations
         record = StepRecord(
             step, t, h, report.iterations, report.residuals, cutbacks, balance.record(q_old, h)
         )
@@ -506,15 +528,28 @@ def solve_transient(
             on_step(record)
         if progress:
             progress(record)
-        if s.checkpoint_every and checkpoint_dir and step % s.checkpoint_every == 0:
-            save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
-        h = control.accepted(report.iterations, cutbacks, error)
-    if checkpoint_dir:
-        save_checkpoint(checkpoint_dir, dyn, balance, t, h, step)
-    seconds = {
-        "compile": compile_time,
-        **solver.seconds,
-        "total": time.perf_counter() - t_start,
-    }
+        if not cutbacks and h < wanted:
+            control.size = wanted
+        control.accepted(report.iterations, cutbacks, error)
+        signum = pending(model.comm)
+        if signum:
+            stopped_by = reason(signum)
+            break
+        if s.checkpoint_every and step % s.checkpoint_every == 0:
+            save(t, step)
+    save(t, step)
+    seconds = {"compile": compile_time, **solver.seconds, "total": time.perf_counter() - t_start}
     solver.destroy()
-    return TransientResult(tuple(records), iterations, seconds, "t_end")
+    return TransientResult(tuple(records), iterations, seconds, stopped_by)
+
+
+def _failure(t, dt_min, tried):
+    """The message of a step that failed at every size: each try and its residuals."""
+    lines = [
+        f"  dt = {dt:.3g}: {why}, residuals {', '.join(f'{r:.3e}' for r in res)}"
+        for dt, why, res in tried
+    ]
+    return (
+        f"time step from t = {t:.6g} failed at every step size down to "
+        f"dt_min = {dt_min:.3g}:\n" + "\n".join(lines)
+    )

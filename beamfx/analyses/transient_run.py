@@ -106,7 +106,9 @@ class Result(_Base):
     restarted_from: float | None = entry("time of the checkpoint restarted from, or None")
     energy: dict | None = entry("energy balance at the last step")
     probe_history: dict = entry("the files of the probe history")
-    stopped_by: str = entry('"t_end" (a failed step raises, with its report)')
+    stopped_by: str = entry(
+        '"t_end", or "interrupted by SIGINT" (SIGTERM) (a failed step raises, with its report)'
+    )
 
     def summary(self) -> dict:
         """The numbers of a sweep table: why the run ended and the number of time steps."""
@@ -178,10 +180,10 @@ class History:
     def _truncate(self, header, t_max):
         """Keep what was written up to the checkpoint at ``t_max``."""
         rows = self.csv.read_text().splitlines() if self.csv.exists() else [header]
-        keep = [r for r in rows[1:] if float(r.split(",")[1]) <= t_max]
-        self.csv.write_text("\n".join([rows[0], *keep]) + "\n")
+        keep = [r for r in rows[1:] if _row_time(r, header.count(",") + 1) <= t_max]
+        self.csv.write_text("\n".join([header, *keep]) + "\n")
         lines = self.jsonl.read_text().splitlines() if self.jsonl.exists() else []
-        keep = [x for x in lines if json.loads(x)["time"] <= t_max]
+        keep = [x for x in lines if _entry_time(x) <= t_max]
         self.jsonl.write_text("".join(x + "\n" for x in keep))
 
     def add(self, r, values):
@@ -213,12 +215,29 @@ class History:
         self.files = None
 
 
+def _row_time(row, columns):
+    """The time of a probes.csv row; infinite for a row cut short (a killed run's last)."""
+    cells = row.split(",")
+    try:
+        return float(cells[1]) if len(cells) == columns else np.inf
+    except ValueError:
+        return np.inf
+
+
+def _entry_time(line):
+    """The time of a probes.jsonl line; infinite for a line cut short."""
+    try:
+        return float(json.loads(line)["time"])
+    except (ValueError, KeyError, TypeError):
+        return np.inf
+
+
 def _start(model, settings, ctx):
     """The checkpoint to go on from (restart), else a static start if asked; the checkpoint."""
+    from .restart import load_restart
     from .static import solve_static
-    from .transient import load_checkpoint
 
-    saved = load_checkpoint(ctx.folder, ctx.comm) if ctx.restart else None
+    saved = load_restart(ctx, settings, model) if ctx.restart else None
     if ctx.restart and saved is None:
         ctx.log("note: no checkpoint for this number of ranks; starting from t = 0")
     if saved is None and settings.start == "static":
@@ -227,7 +246,7 @@ def _start(model, settings, ctx):
         static = solve_static(model, steps=settings.steps, options=opts, log=ctx.log)
         ctx.log(f"static start: {static.newton_iterations} Newton iterations")
     if saved is not None:
-        ctx.frames.resume(saved["t"])
+        ctx.frames.resume(saved[0]["t"])
     return saved
 
 
@@ -248,13 +267,17 @@ def _progress(comm, t_end):
 
 
 def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
-    """March to ``t_end`` (or on from the last checkpoint), writing the history as it goes."""
+    """March to ``t_end`` (or on from the last checkpoint), writing the history as it goes;
+    a SIGINT or SIGTERM stops it at a step ("stopped", with a checkpoint)."""
+    from ..interrupt import deferred
+    from .restart import checkpoint_writer
     from .transient import solve_transient
 
     for w in motion_warnings(ctx.spec, settings.t_end):
         ctx.log(f"warning: {w}")
     saved = _start(model, settings, ctx)
-    history = History(ctx.folder, ctx.probes, ctx.comm, saved["t"] if saved else None)
+    t_restart = saved[0]["t"] if saved else None
+    history = History(ctx.folder, ctx.probes, ctx.comm, t_restart)
     energy = {}
 
     def on_step(r):
@@ -267,29 +290,33 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
 
     bar, progress = _progress(model.comm, settings.t_end)
     try:
-        result = solve_transient(
-            model,
-            settings.solver(),
-            on_step=on_step,
-            log=ctx.log,
-            progress=progress,
-            options=ctx.solver_options,
-            checkpoint_dir=ctx.folder,
-            saved=saved,
-        )
+        with deferred():  # a signal stops the march at a step, with a checkpoint
+            result = solve_transient(
+                model,
+                settings.solver(),
+                on_step=on_step,
+                log=ctx.log,
+                progress=progress,
+                options=ctx.solver_options,
+                checkpoint=checkpoint_writer(ctx, settings, model, history),
+                saved=saved,
+            )
     finally:
         bar.close()
         history.close()
     if result.steps:
         ctx.last_frame(result.steps[-1].step, result.steps[-1].time)
+    stopped = result.stopped_by != "t_end"
     return Result(
         analysis=ctx.analysis,
+        status="stopped" if stopped else "converged",
+        reason=result.stopped_by if stopped else None,
         newton_iterations=int(sum(s.iterations for s in result.steps)),
         seconds=dict(result.seconds),
         scheme=settings.solver().parameters().name,
         t_end=settings.t_end,
         time_steps=len(result.steps),
-        restarted_from=saved["t"] if saved else None,
+        restarted_from=t_restart,
         energy=energy or None,
         probe_history={"csv": history.csv.name, "jsonl": history.jsonl.name},
         stopped_by=result.stopped_by,

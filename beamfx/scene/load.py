@@ -17,6 +17,7 @@ from ..analyses.trimming import PLANE_CHOICES
 from ..geometry import curves
 from ..physics import sections
 from ..physics.kinematics import PLANES, Kinematics
+from ..solvers.options import option_problems
 from ..spec import (
     AXES,
     DOF_NAMES,
@@ -334,6 +335,8 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     probes = _probes(top)
     output = _output(top.table("output", {}))
     solver = top.get("solver", dict, {})
+    for key, message in option_problems(solver):  # an allow-list: no viewers, logs, files
+        top.fail(f"solver.{key}", message)
     accuracy_table = top.table("accuracy", None)
     top.done()
 

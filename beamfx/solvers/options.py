@@ -1,5 +1,8 @@
-"""PETSc options with a mandatory prefix, removed from the global database after use."""
+"""PETSc options with a mandatory prefix, removed from the global database after use, and
+the allow-list of the options a scene may set."""
 
+import math
+import re
 from contextlib import contextmanager
 
 
@@ -16,3 +19,56 @@ def petsc_options(prefix, options):
     finally:
         for key in options:
             db.delValue(f"{prefix}{key}")
+
+
+#: PETSc options a scene's ``[solver]`` table may set (names without prefix): solver types,
+#: tolerances and iteration limits; ``<n>`` stands for a number. Viewers, logs, option files
+#: and the like (they write or read files) are not in it.
+ALLOWED = (
+    "snes_type", "snes_linesearch_type", "snes_linesearch_damping", "snes_linesearch_max_it",
+    "snes_linesearch_order", "snes_rtol", "snes_stol", "snes_max_it", "snes_max_funcs",
+    "snes_divergence_tolerance", "snes_lag_jacobian", "snes_lag_preconditioner",
+    "ksp_type", "ksp_rtol", "ksp_atol", "ksp_divtol", "ksp_max_it", "ksp_gmres_restart",
+    "ksp_norm_type", "ksp_pc_side", "ksp_initial_guess_nonzero",
+    "pc_type", "pc_factor_mat_solver_type", "pc_factor_mat_ordering_type",
+    "pc_factor_shift_type", "pc_factor_shift_amount", "pc_factor_levels", "pc_hypre_type",
+    "pc_gamg_type", "pc_gamg_threshold", "pc_asm_overlap", "sub_pc_type", "sub_ksp_type",
+    "mat_mumps_icntl_<n>", "mat_mumps_cntl_<n>",
+    "eps_type", "eps_tol", "eps_max_it", "eps_ncv", "eps_mpd", "st_type",
+    "st_ksp_type", "st_pc_type", "st_pc_factor_mat_solver_type",
+)  # fmt: skip
+#: options that print to the terminal only: allowed with an empty value (no viewer)
+TERMINAL = (
+    "snes_monitor", "snes_converged_reason", "snes_linesearch_monitor", "ksp_monitor",
+    "ksp_converged_reason", "eps_monitor", "eps_converged_reason",
+)  # fmt: skip
+_WORD = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
+
+
+def _allowed(name):
+    return name in ALLOWED or re.sub(r"_\d{1,4}$", "_<n>", name) in ALLOWED
+
+
+def option_problems(options):
+    """(option, message) of every ``[solver]`` option a scene may not set: names off
+    :data:`ALLOWED` and :data:`TERMINAL`, a value on a terminal option (it would name a
+    viewer, e.g. a file), values that are not a number, true/false or a plain word."""
+    for key, value in options.items():
+        if key in TERMINAL:
+            if value != "":
+                yield key, f'prints to the terminal only: give it as "", not {value!r}'
+            continue
+        if not _allowed(key):
+            yield (
+                key,
+                (
+                    "not allowed from a scene (PETSc options that write or read files, viewers "
+                    f"and logs are refused); allowed: {', '.join(ALLOWED)}, and with the value "
+                    f'"": {", ".join(TERMINAL)}'
+                ),
+            )
+        elif isinstance(value, (bool, int, float)):
+            if isinstance(value, float) and not math.isfinite(value):
+                yield key, f"{value!r} is not a finite number"
+        elif not (isinstance(value, str) and _WORD.fullmatch(value)):
+            yield key, f"{value!r}: expected a number, true/false or a word of letters and digits"
