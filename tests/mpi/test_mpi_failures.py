@@ -1,0 +1,108 @@
+"""A failure on one MPI rank ends the whole job within seconds, with its message: never a hang.
+
+Each case starts ``mpirun -n 2 beamfx run`` in a process of its own with a time limit (from
+the first rank of a plain or an ``mpirun`` pytest; the others skip): a restart whose rank-1
+checkpoint is missing or cut short (every rank reads its file and the ranks agree: exit 2,
+one message), and a write that fails on rank 1 only while rank 0 goes on (rank 1 waits a
+few seconds for the others, then aborts the job: exit 2, its message).
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import pytest
+
+pytestmark = [
+    pytest.mark.mpi,
+    pytest.mark.skipif(
+        os.environ.get("OMPI_COMM_WORLD_RANK", "0") != "0", reason="rank 0 starts the jobs"
+    ),
+    pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun"),
+]
+
+SCENE = """
+[[beams]]
+name = "beam"
+curve = { shape = "line", start = [0, 0, 0], end = [10, 0, 0] }
+section = { type = "general", EA = 2.8e7, GA_y = 1e7, GA_z = 1e7, GJ = 1.4e4, EI_y = 1.4e4, EI_z = 1.4e4, rho_A = 1.2, rho_I = [1.2e-3, 6e-4, 6e-4] }
+elements = 4
+degree = 2
+[model]
+plane = "none"
+[[supports]]
+at = "beam:start"
+fix = "all"
+rotation = [0, 0, 1]
+history = "4 * t**2"
+[analysis]
+type = "transient"
+t_end = 0.1
+dt = 0.005
+checkpoint_every = 5
+[[probes]]
+name = "tip"
+at = "beam:end"
+"""
+LIMIT = 240  # s: a hang would be killed here (a run takes about 10 s)
+
+
+def mpirun(cwd, *args):
+    """``mpirun -n 2 beamfx ...``: (exit status, stderr, seconds), killed after LIMIT."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    env["OMPI_MCA_rmaps_base_oversubscribe"] = "1"
+    command = ["mpirun", "--allow-run-as-root", "-n", "2", sys.executable, "-m", "beamfx.cli"]
+    t = time.monotonic()
+    run = subprocess.run(
+        [*command, *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=LIMIT,
+        check=False,
+    )
+    return run.returncode, run.stderr, time.monotonic() - t
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A folder with the checkpoints of a finished run on 2 ranks."""
+    root = tmp_path_factory.mktemp("mpi")
+    (root / "spin.toml").write_text(SCENE)
+    code, err, _ = mpirun(root, "run", "spin.toml", "--out", "out")
+    assert code == 0, err
+    return root
+
+
+@pytest.mark.parametrize("damage", ["missing", "truncated"])
+def test_a_bad_checkpoint_of_rank_1_stops_every_rank_with_the_message(finished, damage):
+    path = finished / "out" / "checkpoint_2ranks_1.npz"
+    saved = path.read_bytes()
+    try:
+        if damage == "missing":
+            path.unlink()
+            expected = "the checkpoint of rank(s) [1] is missing (checkpoint_2ranks_1.npz)"
+        else:
+            path.write_bytes(saved[: len(saved) // 3])
+            expected = "checkpoint_2ranks_1.npz: not a readable checkpoint"
+        code, err, seconds = mpirun(finished, "run", "spin.toml", "--out", "out", "--restart")
+    finally:
+        path.write_bytes(saved)
+    assert code == 2, err
+    assert err.count(expected) == 1  # printed once, by rank 0
+    assert "Traceback" not in err
+    print(f"{damage}: ended in {seconds:.1f} s")
+
+
+def test_a_failure_on_rank_1_alone_aborts_the_job(tmp_path):
+    """Rank 1 cannot write its checkpoint (its name is taken by a folder); rank 0 has written
+    its own and goes on to the next step's collective calls."""
+    (tmp_path / "spin.toml").write_text(SCENE)
+    (tmp_path / "out" / "checkpoint_2ranks_1.npz").mkdir(parents=True)
+    code, err, seconds = mpirun(tmp_path, "run", "spin.toml", "--out", "out")
+    assert code == 2, err
+    assert "Is a directory" in err and "(rank 1; stopping all ranks)" in err
+    print(f"rank-1 failure: job ended in {seconds:.1f} s")
