@@ -46,6 +46,14 @@ checkpoint_every = 5
 name = "tip"
 at = "beam:end"
 """
+#: the spin-up of tests/scenes/test_restart.py: the tip turns past 2π by t = 0.96
+SPIN = (
+    SCENE.replace(
+        '"4 * t**2"', '"where(t < 0.5, 4 * (t - (0.5 / pi) * sin(pi * t / 0.5)), 8 * t - 2)"'
+    )
+    .replace("t_end = 0.1", "t_end = 1.2")
+    .replace("checkpoint_every = 5", "checkpoint_every = 20")
+)
 LIMIT = 240  # s: a hang would be killed here (a run takes about 10 s)
 
 
@@ -106,3 +114,43 @@ def test_a_failure_on_rank_1_alone_aborts_the_job(tmp_path):
     assert code == 2, err
     assert "Is a directory" in err and "(rank 1; stopping all ranks)" in err
     print(f"rank-1 failure: job ended in {seconds:.1f} s")
+
+
+@pytest.mark.slow
+def test_two_ranks_interrupted_and_restarted_equal_the_whole_run(tmp_path):
+    """The spin-up of tests/scenes/test_restart.py on 2 ranks: SIGINT to mpirun (which sends
+    SIGTERM to the ranks) past the tip's 2π, then --restart: the history equals that of the
+    whole 2-rank run to 1e-12 of each column's size."""
+    import signal
+
+    import numpy as np
+
+    (tmp_path / "spin.toml").write_text(SPIN)
+    code, err, _ = mpirun(tmp_path, "run", "spin.toml", "--out", "whole")
+    assert code == 0, err
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    command = ["mpirun", "--allow-run-as-root", "-n", "2", sys.executable, "-m", "beamfx.cli"]
+    run = subprocess.Popen(
+        [*command, "run", "spin.toml", "--out", "part"],
+        cwd=tmp_path,
+        env=env | {"OMPI_MCA_rmaps_base_oversubscribe": "1"},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    csv = tmp_path / "part" / "probes.csv"
+    while run.poll() is None:
+        if csv.exists() and csv.read_text().count("\n") >= 200:
+            run.send_signal(signal.SIGINT)
+            break
+        time.sleep(0.005)
+    _, err = run.communicate(timeout=LIMIT)
+    assert "stopped: interrupted by SIGTERM" in err
+    code, err, _ = mpirun(tmp_path, "run", "spin.toml", "--out", "part", "--restart")
+    assert code == 0, err
+    a, b = (np.genfromtxt(tmp_path / f / "probes.csv", delimiter=",", names=True)
+            for f in ("whole", "part"))  # fmt: skip
+    assert len(a) == len(b) == 241
+    for name in a.dtype.names:
+        scale = max(1.0, np.max(np.abs(a[name])))
+        np.testing.assert_allclose(b[name], a[name], rtol=0, atol=1e-12 * scale, err_msg=name)
