@@ -38,6 +38,7 @@ class Interrupted(KeyboardInterrupt):
 
     @property
     def exit_code(self):
+        """The exit status of a command ended by the signal: 128 + its number."""
         return 128 + self.signum
 
 
