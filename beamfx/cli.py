@@ -156,7 +156,7 @@ def main(argv=None):
 def _guarded(args, parallel):
     """(exit status, message or None) of the command: errors become one line; a traceback
     only for a bug in a serial run (under MPI it is printed and every rank stops)."""
-    from .interrupt import Interrupted
+    from .interrupt import Interrupted, interruption
     from .scene import SceneError
     from .solvers import SolveFailed
 
@@ -164,11 +164,14 @@ def _guarded(args, parallel):
         return COMMANDS[args.command](args), None
     except Interrupted as e:
         return e.exit_code, f"beamfx: {e}"
-    except (SceneError, ValueError, OSError) as e:
-        return 2, f"beamfx: error: {e}"
-    except SolveFailed as e:
-        return 3, f"beamfx: solve failed: {e}"
-    except Exception:
+    except Exception as e:
+        signal = interruption(e)  # a signal that surfaced as another error (in an import)
+        if signal is not None:
+            return signal.exit_code, f"beamfx: {signal}"
+        if isinstance(e, (SceneError, ValueError, OSError)):
+            return 2, f"beamfx: error: {e}"
+        if isinstance(e, SolveFailed):
+            return 3, f"beamfx: solve failed: {e}"
         if not parallel:
             raise
         import traceback

@@ -42,6 +42,19 @@ class Interrupted(KeyboardInterrupt):
         return 128 + self.signum
 
 
+def interruption(error):
+    """The :class:`Interrupted` that ``error`` is or was raised from (a signal that arrived in
+    an import or a C callback comes back as another exception, e.g. ``ImportError:
+    initialization failed``), or None."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, Interrupted):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 def reason(signum):
     """``interrupted by SIGINT`` (the words of results.json)."""
     return f"interrupted by {signal.Signals(signum).name}"
@@ -134,6 +147,7 @@ __all__ = [
     "deferred",
     "error_comm",
     "handle_signals",
+    "interruption",
     "pending",
     "reason",
     "received",

@@ -202,11 +202,14 @@ def claim(folder, comm, scene, restart=False, log=None):
         raise FolderError(error)
     try:
         yield
-    except KeyboardInterrupt as e:  # beamfx.interrupt.Interrupted: say so in results.json
+    except BaseException as e:  # interrupted by a signal: say so in results.json
+        from ..interrupt import interruption
         from .results import write_json_atomic
 
-        stopped = {"scene": str(scene), "converged": False, "status": "stopped"}
-        write_json_atomic(Path(folder) / "results.json", {**stopped, "reason": str(e)}, comm)
+        signal = interruption(e)
+        if signal is not None:
+            stopped = {"scene": str(scene), "converged": False, "status": "stopped"}
+            write_json_atomic(Path(folder) / "results.json", {**stopped, "reason": str(signal)}, comm)
         raise
     finally:
         if lock:
