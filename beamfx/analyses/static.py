@@ -54,13 +54,37 @@ def load_scale(model, F):
     return norm
 
 
+def state_sizes(model):
+    """Per owned unknown of ``model.w``, the size added to |x| in Newton's round-off floor
+    (:meth:`~beamfx.solvers.snes.NewtonSolver.set_sizes`): the node spacing (cell length over
+    the degree) for a displacement, whose derivative adds to the unit reference tangent, and 1
+    for a rotation unknown. None for a model without a beam discretisation."""
+    from .dofs import owned_size, subspace_dofs
+
+    d = getattr(model, "discretisation", None)
+    if d is None or not hasattr(model, "W"):
+        return None
+    W = model.W
+    if type(W.ufl_element()).__name__ != "MixedElement":  # rotations only (condensed model)
+        return np.ones(owned_size(W))
+    cells = np.diff(d.mesh.cell_span, axis=1).ravel() / model.degree
+    dofs = W.dofmap.list.array.reshape(len(cells), -1)
+    spacing = np.zeros(len(model.w.x.array))
+    np.maximum.at(spacing, dofs, cells[:, None])
+    sizes = np.ones_like(spacing)
+    disp = subspace_dofs(W, 0)
+    sizes[disp] = spacing[disp]
+    return sizes[: owned_size(W)]
+
+
 def solve_static(
     model, steps=10, options=None, prefix="beamfx_static_", on_step=None, log=None, solver=None
 ):
     """Nonlinear static equilibrium at load factor 1, reached by adaptive load stepping.
 
-    The linear kinematics take a single step (the problem is linear). Newton's absolute
-    tolerance is 1e-10 of the load vector's norm.
+    The linear kinematics take a single step (the problem is linear). Newton's test
+    (:mod:`~beamfx.solvers.convergence`) scales the residual by the load vector's norm (or
+    the reactions) and knows the round-off floor of the model's stiffness and state.
     """
     t0 = time.perf_counter()
     from ..solvers.forms import compile_seconds
@@ -69,12 +93,13 @@ def solve_static(
     solver = solver or NewtonSolver(
         model.F, model.J, model.w, model.bcs, prefix, options, coupling=model.coupling
     )
-    scale = load_scale(model, solver.F)
-    solver.set_atol(max(1e-10 * scale, 1e-14))
+    full_load = load_scale(model, solver.F)
+    solver.set_sizes(state_sizes(model))
     compile_time = compile_seconds[0] - c0
 
     def solve_at(lam):
         model.set_load_factor(lam)
+        solver.set_scale(lam * full_load)  # the load at this step (the reactions count too)
         report = solver.solve()
         if report.converged:
             model.check_state()  # e.g. the condensed model's range of rotations: raises

@@ -1,11 +1,15 @@
 """Assembly of residual, tangent and load vector with Dirichlet conditions (one place for all
 solvers: Newton, arc length, load scaling)."""
 
+import numpy as np
 
-def assemble_residual(b, F, J, bcs, x):
+
+def assemble_residual(b, F, J, bcs, x, rows=None):
     """Residual b = F with lifting of ``bcs`` about ``x``, b = x - g on constrained rows (b zeroed).
 
     The Newton correction then drives the constrained dofs to their prescribed values g.
+    ``rows``: owned local rows (the constrained ones) whose assembled F (the reactions) is
+    measured before it is replaced; returns the local sum of their squares (0 without).
     """
     import dolfinx.fem.petsc as fp
     from petsc4py import PETSc
@@ -15,7 +19,11 @@ def assemble_residual(b, F, J, bcs, x):
     fp.assemble_vector(b, F)
     fp.apply_lifting(b, [J], bcs=[bcs], x0=[x], scale=-1.0)
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    local = 0.0
+    if rows is not None and len(rows):
+        local = float(np.sum(b.getArray(readonly=True)[rows] ** 2))
     fp.set_bc(b, bcs, x, -1.0)
+    return local
 
 
 def assemble_tangent(A, J, bcs):

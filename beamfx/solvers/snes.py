@@ -6,16 +6,17 @@ from typing import NamedTuple
 import numpy as np
 
 from .assembly import assemble_residual, assemble_tangent
+from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
 from .options import petsc_options
 
 #: defaults chosen for beams (notes §4): full Newton steps (the bt line search stalls on the
-#: stiff axial term), no divergence or step-size stop, LU with MUMPS
+#: stiff axial term), no divergence stop, LU with MUMPS. The convergence test is beamfx's
+#: (:mod:`~beamfx.solvers.convergence`): snes_atol and snes_rtol are read by it, snes_stol is
+#: not used (a small step alone is not convergence)
 DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
     "snes_linesearch_type": "basic",
-    "snes_rtol": 1e-10,
-    "snes_stol": 1e-13,
     "snes_max_it": 25,
     "snes_divergence_tolerance": -1,
     "ksp_type": "preonly",
@@ -47,29 +48,34 @@ class SolveReport(NamedTuple):
     """The outcome of a nonlinear solve: converged, why, the iterations and wall times."""
 
     converged: bool
-    reason: str
+    reason: str  # PETSc's name (convergence.REASONS says what it means)
     iterations: int
     residuals: tuple  # ‖F‖ at each iteration
     seconds: dict  # wall time: assemble_F, assemble_J, solve (= the rest: factorise,
-    # triangular_solve, python = Python, SNES and vector work)
+    # triangular_solve, python = Python, SNES and vector work, test = the convergence test)
+    criterion: str | None = None  # how it converged: 'residual', 'floor', 'relative'
+    cause: str | None = None  # why it failed (convergence.REMEDIES' keys)
+    detail: str | None = None  # the numbers behind the cause
+    floor: float | None = None  # the round-off floor estimate at the last iterate, if known
 
 
 class SolveFailed(RuntimeError):
-    """A nonlinear solve that did not converge, with what was tried."""
+    """A numerical failure, with what was tried: ``history`` (accepted steps, or the eigen
+    values found), ``cause`` and ``remedy`` (strings or None) and ``details`` (a dict for
+    results.json)."""
 
-    def __init__(self, message, history=()):
+    def __init__(self, message, history=(), cause=None, remedy=None, details=None):
         super().__init__(message)
-        self.history = history
-
-
-def _reason_names():
-    from petsc4py import PETSc
-
-    return {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if not k.startswith("_")}
+        self.history, self.cause, self.remedy = history, cause, remedy
+        self.details = details or {}
 
 
 class NewtonSolver:
     """SNES over ``F(w) = 0`` with Jacobian ``J``; the state lives in the Function ``w``.
+
+    Converged means :class:`~beamfx.solvers.convergence.ScaledTest` holds: set the force scale
+    (:meth:`set_scale`) and the sizes added to the state in the floor estimate
+    (:meth:`set_sizes`); the reactions are measured at every residual.
 
     Args:
         F, J: UFL residual and Jacobian forms.
@@ -92,19 +98,25 @@ class NewtonSolver:
         self.b = fp.create_vector(self.F)
         self.A = fp.create_matrix(self.J)
         self.x = w.vector.copy()
-        self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0}
+        self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0, "test": 0.0}
         linear_solve_seconds()  # start PETSc's event log before the first solve
         self._residuals = []
+        self.options = {**DEFAULT_OPTIONS, **(options or {})}
+        self.atol = float(self.options.get("snes_atol", 0.0))
+        self.rtol = float(self.options.get("snes_rtol", 0.0))
+        self.force_scale, self.reactions, self.sizes = 0.0, 0.0, None
+        self._rows = _constrained_rows(bcs, self.b.getLocalSize())
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
         snes.setFunction(self._residual, self.b)
         snes.setJacobian(self._jacobian, self.A)
         snes.setMonitor(lambda s, it, norm: self._residuals.append(norm))
-        self.options = {**DEFAULT_OPTIONS, **(options or {})}
         with petsc_options(prefix, self.options):
             snes.setFromOptions()
             snes.getKSP().setFromOptions()
+        self.test = ScaledTest(self)
+        snes.setConvergenceTest(self._test)
         self.snes = snes
 
     def _residual(self, snes, x, b):
@@ -116,7 +128,8 @@ class NewtonSolver:
         self.w.x.scatter_forward()
         if self.coupling:
             self.coupling.update()
-        assemble_residual(b, self.F, self.J, self.bcs, x)
+        local = assemble_residual(b, self.F, self.J, self.bcs, x, rows=self._rows)
+        self.reactions = float(np.sqrt(self.w.function_space.mesh.comm.allreduce(local)))
         self.seconds["assemble_F"] += time.perf_counter() - t
 
     def _jacobian(self, snes, x, A, P):
@@ -126,14 +139,30 @@ class NewtonSolver:
             self.coupling.add_to_tangent(A)
         self.seconds["assemble_J"] += time.perf_counter() - t
 
+    def _test(self, snes, it, norms):
+        t = time.perf_counter()
+        reason = self.test(snes, it, norms)
+        self.seconds["test"] += time.perf_counter() - t
+        return reason
+
     def set_atol(self, atol):
         """Absolute residual tolerance, in the units of the residual (force, moment)."""
-        rtol, _, stol, max_it = self.snes.getTolerances()
-        self.snes.setTolerances(rtol=rtol, atol=atol, stol=stol, max_it=max_it)
+        self.atol = float(atol)
+
+    def set_scale(self, force):
+        """The force scale of the residual criterion (e.g. the load vector's norm); the
+        reactions at the iterate count when larger."""
+        self.force_scale = float(force)
+
+    def set_sizes(self, sizes):
+        """Per owned unknown, a size added to |x| in the round-off floor estimate (the terms of
+        the reference state: e.g. the element length for a displacement, 1 for a rotation)."""
+        self.sizes = None if sizes is None else np.asarray(sizes, float)
 
     def solve(self):
         """Run Newton from the current ``w``; ``w`` holds the last iterate. Returns a report."""
         self._residuals = []
+        self.test.reset()
         before = dict(self.seconds)
         linear_before = linear_solve_seconds()
         t = time.perf_counter()
@@ -142,34 +171,57 @@ class NewtonSolver:
         self.x.copy(self.w.vector)
         self.w.x.scatter_forward()
         code = self.snes.getConvergedReason()
-        total = time.perf_counter() - t
+        seconds = self._split(before, linear_before, time.perf_counter() - t)
+        reason = reason_names().get(code, str(code))
+        if code > 0 and self.test.how is not None:
+            return SolveReport(
+                True,
+                reason,
+                self.snes.getIterationNumber(),
+                tuple(self._residuals),
+                seconds,
+                criterion=self.test.how,
+            )
+        floor = self.test.absolute.floor(self.A, self.x, self.sizes)
+        cause, detail = diagnose(reason, self.test.records, floor)
+        return SolveReport(
+            False,
+            reason,
+            self.snes.getIterationNumber(),
+            tuple(self._residuals),
+            seconds,
+            cause=cause,
+            detail=detail,
+            floor=floor,
+        )
+
+    def _split(self, before, linear_before, total):
+        """This solve's wall-time split (and the running totals in ``self.seconds``)."""
         seconds = {k: self.seconds[k] - before[k] for k in self.seconds}
         seconds["solve"] = total - seconds["assemble_F"] - seconds["assemble_J"]
         self.seconds["solve"] += seconds["solve"]
         linear = linear_solve_seconds()
         for key in LINEAR_EVENTS:
             seconds[key] = linear[key] - linear_before[key]
-        seconds["python"] = seconds["solve"] - seconds["factorise"] - seconds["triangular_solve"]
+        seconds["python"] = (
+            seconds["solve"] - seconds["factorise"] - seconds["triangular_solve"] - seconds["test"]
+        )
         for key in (*LINEAR_EVENTS, "python"):
             self.seconds[key] = self.seconds.get(key, 0.0) + seconds[key]
-        residuals = tuple(self._residuals)
-        # a step-size (stol) stop is only convergence if the residual did not grow
-        converged = (
-            code > 0
-            and np.all(np.isfinite(residuals))
-            and (len(residuals) < 2 or residuals[-1] <= residuals[0])
-        )
-        return SolveReport(
-            bool(converged),
-            _reason_names().get(code, str(code)),
-            self.snes.getIterationNumber(),
-            residuals,
-            seconds,
-        )
+        return seconds
 
     def destroy(self):
         """Free the SNES and its matrix and vectors."""
         self.snes.destroy()
+        self.test.destroy()
         self.A.destroy()
         self.b.destroy()
         self.x.destroy()
+
+
+def _constrained_rows(bcs, n_owned):
+    """Owned local rows of the dofs constrained by ``bcs`` (where the reactions are)."""
+    if not bcs:
+        return np.empty(0, np.int32)
+    rows = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
+    return rows[rows < n_owned]

@@ -2,6 +2,7 @@
 
 from typing import NamedTuple
 
+from .convergence import describe, remedy
 from .snes import SolveFailed
 
 
@@ -29,6 +30,7 @@ class LoadStep(NamedTuple):
     iterations: int
     residuals: tuple
     cutbacks: int
+    converged_by: str = "residual"  # the criterion that held: 'residual', 'floor', 'relative'
 
 
 def step_load(
@@ -75,13 +77,20 @@ def step_load(
         report = solve_at(target)
         if report.converged:
             item = LoadStep(
-                len(history) + 1, target, report.iterations, report.residuals, len(tried)
+                len(history) + 1,
+                target,
+                report.iterations,
+                report.residuals,
+                len(tried),
+                report.criterion or "residual",
             )
             history.append(item)
             if log:
+                at_floor = " (at the round-off floor)" if item.converged_by == "floor" else ""
                 log(
                     f"step {item.step}: load factor {target:.6g}, {report.iterations} Newton "
                     f"iterations, |F| {report.residuals[-1] if report.residuals else 0:.3e}"
+                    + at_floor
                 )
             if on_step:
                 on_step(item)
@@ -89,22 +98,39 @@ def step_load(
             control.accepted(report.iterations)
             continue
         state.restore()
-        tried.append((target, report.reason, report.residuals))
+        tried.append((target, report))
         if log:
             log(
                 f"step {len(history) + 1}: no convergence at load factor {target:.6g} "
-                f"({report.reason}); cutting the step back"
+                f"({report.reason}: {report.cause}); cutting the step back"
             )
         try:
             control.rejected()
         except StepTooSmall:
-            lines = "\n".join(
-                f"  load factor {t:.6g}: {r}, |F| = " + ", ".join(f"{x:.3e}" for x in res)
-                for t, r, res in tried
-            )
-            raise SolveFailed(
-                f"Newton failed at step {len(history) + 1} after {len(tried)} attempts, the "
-                f"last converged load factor is {lam:.6g}; tried:\n{lines}",
-                history,
-            ) from None
+            raise _failure(history, lam, tried, 4 * steps) from None
     return history
+
+
+def _failure(history, lam, tried, steps):
+    """The :class:`SolveFailed` of a load step that cannot be cut back further: the cause and
+    remedy of the last attempt, every attempt's residuals."""
+    last = tried[-1][1]
+    fix = remedy(last.cause, steps)
+    lines = "\n".join(
+        f"  load factor {t:.6g}: {r.reason} ({r.cause}), |F| = "
+        + ", ".join(f"{x:.3e}" for x in r.residuals)
+        for t, r in tried
+    )
+    message = (
+        f"Newton failed at step {len(history) + 1} after {len(tried)} attempts, the last "
+        f"converged load factor is {lam:.6g}; cause: {last.cause} ({last.detail}); "
+        f"PETSc: {describe(last.reason)}; remedy: {fix}; tried:\n{lines}"
+    )
+    details = {
+        "load_factor": lam,
+        "attempts": [
+            {"load_factor": t, "reason": r.reason, "cause": r.cause, "residuals": list(r.residuals)}
+            for t, r in tried
+        ],
+    }
+    return SolveFailed(message, history, last.cause, fix, details)

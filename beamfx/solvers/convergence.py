@@ -1,0 +1,232 @@
+"""Newton's convergence test with a scale, and what a stop means.
+
+The residual of an assembled nonlinear problem cannot fall below a round-off floor: each entry
+is a sum of terms (stiffness times state) that cancel at equilibrium, and every term carries a
+relative error of about the machine epsilon. With a stiff axial term (EA·L²/EI of 1e8 and
+more) that floor, about eps·EA, lies far above a tolerance of 1e-10 of the load, and Newton
+stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes_atol``,
+``snes_rtol``, ``snes_stol``) with:
+
+* **residual**: ‖F‖ ≤ max(atol, 1e-10·S), S the force scale of the model: the load norm given
+  by the analysis or the norm of the reactions (the internal force at the supports), the
+  larger;
+* **floor**: ‖F‖ ≤ :data:`FLOOR_LIMIT`·S and ‖F‖ ≤ :data:`FLOOR_FACTOR` × the round-off floor ε‖ |K| (|x| + s) ‖ (|K| the
+  tangent's entries in absolute value, s a size per unknown added to the state, e.g. the
+  element length for displacements, so that the terms of the reference geometry count)
+  *and* the increment criteria hold: the last correction is small against the state,
+  ‖du‖ ≤ :data:`INCREMENT_TOL`·‖x‖, and its energy is small, |du·F| ≤ :data:`ENERGY_TOL`·E
+  with E the larger of the solve's largest correction energy and the state's |x·Kx|;
+* **relative** (only if ``snes_rtol`` is given in ``[solver]``): ‖F‖ ≤ rtol·‖F₀‖ and the
+  increment criteria hold.
+
+A step-size stop alone is never convergence. Every stop is reported by its PETSc name with
+:data:`REASONS`; a failure also by a cause and a remedy (:func:`diagnose`).
+"""
+
+import numpy as np
+
+#: residual tolerance relative to the force scale S
+RESIDUAL_TOL = 1e-10
+#: how far above the estimated round-off floor a residual still counts as at the floor
+FLOOR_FACTOR = 10.0
+#: the floor is accepted only if the residual is also below this fraction of the force scale
+#: (five digits of equilibrium); a floor above it means the state cannot be resolved
+FLOOR_LIMIT = 1e-5
+#: the increment criterion at the floor: ‖du‖ ≤ INCREMENT_TOL·‖x‖
+INCREMENT_TOL = 1e-6
+#: the energy criterion at the floor (quadratic in the error: INCREMENT_TOL²)
+ENERGY_TOL = 1e-12
+
+#: PETSc's SNES reasons and what they mean here
+REASONS = {
+    "CONVERGED_FNORM_ABS": "residual below the scaled absolute tolerance (residual criterion)",
+    "CONVERGED_FNORM_RELATIVE": "residual reduced by snes_rtol, with a small increment",
+    "CONVERGED_SNORM_RELATIVE": "residual at its round-off floor, with a small increment and "
+    "energy (floor criterion)",
+    "CONVERGED_ITS": "stopped at a fixed number of iterations (snes_type ksponly)",
+    "CONVERGED_ITERATING": "still iterating",
+    "DIVERGED_MAX_IT": "snes_max_it iterations without meeting the convergence test",
+    "DIVERGED_LINE_SEARCH": "the line search found no decrease of the residual",
+    "DIVERGED_LINEAR_SOLVE": "the linear solve failed (singular or indefinite tangent)",
+    "DIVERGED_FNORM_NAN": "the residual became NaN or infinite",
+    "DIVERGED_DTOL": "the residual grew beyond snes_divergence_tolerance times the first one",
+    "DIVERGED_FUNCTION_DOMAIN": "the state left the domain of the residual",
+    "DIVERGED_FUNCTION_COUNT": "too many residual evaluations (snes_max_funcs)",
+    "DIVERGED_LOCAL_MIN": "stuck in a local minimum of the residual norm",
+    "DIVERGED_INNER": "an inner solve failed",
+    "DIVERGED_JACOBIAN_DOMAIN": "the tangent could not be evaluated at the state",
+    "DIVERGED_TR_DELTA": "the trust region became too small",
+}
+
+#: remedies by cause
+REMEDIES = {
+    "divergence": "smaller load steps: [analysis] steps = {steps} (or more)",
+    "stagnation above the floor": "smaller load steps: [analysis] steps = {steps}; if it "
+    'persists, the load may be past a limit point (use type = "arclength")',
+    "floor above the force scale": "a smaller load (check its units: the displacements and "
+    "rotations reached are far outside the model's range) or a stiffer section",
+    "stagnation at the floor": "the increments do not settle at the round-off floor: the "
+    "stiffness ratio is too large for double precision on this mesh (fewer or lower-degree "
+    "elements, or shear = false / stretch = false in [model])",
+    "max iterations": "more iterations ([solver] snes_max_it = 50) or smaller load steps: "
+    "[analysis] steps = {steps}",
+    "line search": 'the default full Newton step: [solver] snes_linesearch_type = "basic"',
+    "linear solve": "check supports: the structure is a mechanism or lost its stiffness "
+    '(a limit point: use type = "arclength")',
+    "nan": "smaller load steps: [analysis] steps = {steps}; a NaN also comes from a state "
+    "outside the model's range (a folded element)",
+    "other": "see the PETSc reason",
+}
+
+
+def reason_names():
+    """{code: name} of PETSc's SNES reasons."""
+    from petsc4py import PETSc
+
+    return {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if not k.startswith("_")}
+
+
+def describe(reason):
+    """'NAME (what it means)' of a PETSc reason name."""
+    return f"{reason} ({REASONS[reason]})" if reason in REASONS else str(reason)
+
+
+class AbsoluteTangent:
+    """|K|·v for the round-off floor: a matrix of the tangent's pattern with its entries in
+    absolute value (refilled from the tangent on each call)."""
+
+    def __init__(self, A):
+        self.B = A.duplicate(copy=False)
+        self.v, self.out = A.createVecs()
+
+    def floor(self, A, x, sizes):
+        """ε‖ |A| (|x| + sizes) ‖₂ (``sizes``: local owned array or None). Collective."""
+        rows, cols, vals = A.getValuesCSR()
+        self.B.setValuesCSR(rows, cols, np.abs(vals))
+        self.B.assemble()
+        state = np.abs(x.getArray(readonly=True))
+        self.v.setArray(state if sizes is None else state + sizes)
+        self.B.mult(self.v, self.out)
+        return float(np.finfo(float).eps * self.out.norm())
+
+    def destroy(self):
+        for obj in (self.B, self.v, self.out):
+            obj.destroy()
+
+
+class ScaledTest:
+    """The convergence test (module docstring) as a SNES convergence callback; one record per
+    iteration in ``records``, and ``how`` the last solve converged ('residual', 'floor',
+    'relative') or None."""
+
+    def __init__(self, solver):
+        self.solver = solver  # NewtonSolver: A, atol, rtol, force_scale, reactions, sizes
+        self.absolute = AbsoluteTangent(solver.A)
+        self.F_prev, self.Kx = solver.b.duplicate(), solver.b.duplicate()
+        self.reset()
+
+    def reset(self):
+        self.records, self.how = [], None
+        self.first_energy, self.state_energy, self.floor = 0.0, None, None
+
+    def __call__(self, snes, it, norms):
+        from petsc4py import PETSc
+
+        reason = PETSc.SNES.ConvergedReason
+        xnorm, ynorm, fnorm = norms
+        s = self.solver
+        record = {"fnorm": fnorm, "step": ynorm, "state": xnorm, "energy": None, "floor": None}
+        self.records.append(record)
+        scale = max(s.force_scale, s.reactions)
+        record["scale"] = scale
+        tol = max(s.atol, RESIDUAL_TOL * scale)
+        F = snes.getFunction()[0]
+        if it > 0:
+            record["energy"] = abs(snes.getSolutionUpdate().dot(self.F_prev))
+            self.first_energy = max(self.first_energy or 0.0, record["energy"])
+        F.copy(self.F_prev)
+        if not np.isfinite(fnorm):
+            return reason.DIVERGED_FNORM_NAN
+        if fnorm <= tol:
+            self.how = "residual"
+            return reason.CONVERGED_FNORM_ABS
+        if it == 0 or not self.increment_small(record, snes.getSolution()):
+            return reason.CONVERGED_ITERATING
+        if s.rtol and fnorm <= s.rtol * self.records[0]["fnorm"]:
+            self.how = "relative"
+            return reason.CONVERGED_FNORM_RELATIVE
+        if self.floor is None:  # once per solve: the tangent hardly changes at this stage
+            self.floor = self.absolute.floor(s.A, snes.getSolution(), s.sizes)
+        record["floor"] = self.floor
+        if fnorm <= FLOOR_FACTOR * self.floor and fnorm <= FLOOR_LIMIT * scale:
+            self.how = "floor"
+            return reason.CONVERGED_SNORM_RELATIVE
+        return reason.CONVERGED_ITERATING
+
+    def increment_small(self, record, x):
+        """The increment criteria of the last iteration: ‖du‖ ≤ INCREMENT_TOL·‖x‖ and
+        |du·F| ≤ ENERGY_TOL·E, E the larger of the solve's largest correction energy and the
+        state's |x·Kx| (K the last tangent)."""
+        if record["step"] > INCREMENT_TOL * record["state"]:
+            return False
+        if self.state_energy is None:
+            self.solver.A.mult(x, self.Kx)
+            self.state_energy = abs(x.dot(self.Kx))
+        record["reference"] = max(self.first_energy, self.state_energy)
+        return record["energy"] <= ENERGY_TOL * record["reference"]
+
+    def destroy(self):
+        self.absolute.destroy()
+        self.F_prev.destroy()
+        self.Kx.destroy()
+
+
+def _stagnates(f):
+    """The last three residuals within a factor 10 of one another (no Newton progress)."""
+    tail = f[-3:]
+    return len(tail) == 3 and max(tail) <= 10 * min(tail)
+
+
+def diagnose(reason, records, floor):
+    """(cause, detail) of a failed solve: the PETSc ``reason`` name, the test's per-iteration
+    ``records`` and the round-off ``floor`` estimated at the last iterate."""
+    f = [r["fnorm"] for r in records]
+    if reason == "DIVERGED_FNORM_NAN" or not np.all(np.isfinite(f)):
+        return "nan", "the residual is not finite"
+    simple = {
+        "DIVERGED_LINEAR_SOLVE": "linear solve",
+        "DIVERGED_LINE_SEARCH": "line search",
+        "DIVERGED_DTOL": "divergence",
+    }
+    if reason in simple:
+        return simple[reason], describe(reason)
+    if not f:
+        return "other", describe(reason)
+    last, least = f[-1], min(f)
+    numbers = f"|F| from {f[0]:.3e} to {last:.3e} (least {least:.3e}), round-off floor {floor:.3e}"
+    if len(f) > 1 and min(f[len(f) // 2 :]) > f[0]:
+        return "divergence", f"the residual grew: {numbers}"
+    scale = records[-1].get("scale", 0.0)
+    if _stagnates(f) and last <= FLOOR_FACTOR * floor and last > FLOOR_LIMIT * scale:
+        return "floor above the force scale", (
+            f"{numbers}; the residual cannot be resolved below {last / scale:.1e} of the force "
+            f"scale {scale:.3e} (needed: {FLOOR_LIMIT:g}): the state is outside what double "
+            "precision resolves (huge stretches or rotations, or an extreme stiffness ratio)"
+        )
+    if _stagnates(f) and last <= FLOOR_FACTOR * floor:
+        r = records[-1]
+        step = r["step"] / r["state"] if r["state"] else np.inf
+        return "stagnation at the floor", (
+            f"{numbers}; the last increment |du|/|x| = {step:.2e} (criterion {INCREMENT_TOL:g})"
+        )
+    if _stagnates(f):
+        return "stagnation above the floor", numbers
+    if reason == "DIVERGED_MAX_IT":
+        return "max iterations", f"still converging: {numbers}"
+    return "other", f"{describe(reason)}: {numbers}"
+
+
+def remedy(cause, steps=None):
+    """The remedy of a ``cause`` (REMEDIES), with a number of load steps to suggest if known."""
+    text = REMEDIES.get(cause or "other", REMEDIES["other"])
+    return text.format(steps=steps if steps else "<more than now>")
