@@ -107,7 +107,7 @@ def run_scene(
     with claim(out, comm, path, restart, log):  # locked, an earlier run's files removed
         scene, refinement = _refine(scene, comm, log)
         ctx = _context(scene, out, comm, log, restart, png or animate)
-        result = analysis(scene.analysis).run(ctx.model, scene.settings, ctx)
+        result = _analyse(analysis(scene.analysis), scene, ctx, log)
         ctx.frames.close()
         run = RunResult(
             str(path),
@@ -119,6 +119,20 @@ def run_scene(
             refinement.entry(scene.accuracy) if refinement else None,
         )
         return _finish(run, out, scene, refinement, log, comm, png, animate)
+
+
+def _analyse(kind, scene, ctx, log):
+    """The analysis's Result; a numerical failure (SolveFailed) becomes a failed Result, so
+    that results.json is written and says why (``beamfx run`` then exits 3)."""
+    from .analyses.result import failed
+    from .solvers import SolveFailed
+
+    t0 = time.perf_counter()
+    try:
+        return kind.run(ctx.model, scene.settings, ctx)
+    except SolveFailed as e:
+        log(f"failed: {e}")
+        return failed(ctx.analysis, e, {"total": time.perf_counter() - t0})
 
 
 def _prepare(out, scene, comm, named_by_scene):

@@ -41,6 +41,8 @@ class Result:
             the last static solve, if any.
         newton_iterations: Newton iterations of the analysis.
         seconds: wall time split (compile, assemble_F, assemble_J, solve, total, ...).
+        cause, remedy: of a numerical failure (see :mod:`beamfx.solvers.convergence`).
+        failure: what a failed solve tried (attempts and their residuals, eigenvalues found).
     """
 
     analysis: str
@@ -49,13 +51,17 @@ class Result:
     load_steps: tuple = ()
     newton_iterations: int = 0
     seconds: dict = field(default_factory=dict)
+    cause: str | None = None
+    remedy: str | None = None
+    failure: dict | None = None
 
     def to_json(self) -> dict:
         """The analysis's entries of ``results.json`` (plain lists and numbers)."""
         out = {"analysis": self.analysis, "converged": self.status == "converged"}
         out["status"] = self.status
-        if self.reason is not None:
-            out["reason"] = self.reason
+        for key in ("reason", "cause", "remedy", "failure"):
+            if getattr(self, key) is not None:
+                out[key] = plain(getattr(self, key))
         out["load_steps"] = [
             {
                 "step": s.step,
@@ -63,6 +69,7 @@ class Result:
                 "newton_iterations": s.iterations,
                 "residuals": list(s.residuals),
                 "cutbacks": s.cutbacks,
+                "converged_by": getattr(s, "converged_by", "residual"),
             }
             for s in self.load_steps
         ]
@@ -78,9 +85,27 @@ class Result:
         return {}
 
 
+def failed(analysis: str, error: Exception, seconds: dict | None = None) -> "Result":
+    """The :class:`Result` of an analysis that raised ``error`` (a
+    :class:`~beamfx.solvers.snes.SolveFailed`): status "failed", the first line of its message
+    as the reason, its cause, remedy and details, and the load steps it had accepted."""
+    steps = tuple(s for s in getattr(error, "history", ()) if hasattr(s, "load_factor"))
+    return Result(
+        analysis=analysis,
+        status="failed",
+        reason=str(error).splitlines()[0] if str(error) else type(error).__name__,
+        load_steps=steps,
+        newton_iterations=int(sum(s.iterations for s in steps)),
+        seconds=dict(seconds or {}),
+        cause=getattr(error, "cause", None),
+        remedy=getattr(error, "remedy", None),
+        failure=dict(getattr(error, "details", None) or {}) or None,
+    )
+
+
 def entry(doc: str = "") -> Any:
     """A result field (documentation only; every field goes into ``results.json``)."""
     return field(metadata={"doc": doc})
 
 
-__all__ = ["STATUSES", "Result", "entry", "plain"]
+__all__ = ["STATUSES", "Result", "entry", "failed", "plain"]

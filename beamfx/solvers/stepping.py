@@ -124,7 +124,7 @@ def _failure(history, lam, tried, steps):
     message = (
         f"Newton failed at step {len(history) + 1} after {len(tried)} attempts, the last "
         f"converged load factor is {lam:.6g}; cause: {last.cause} ({last.detail}); "
-        f"PETSc: {describe(last.reason)}; remedy: {fix}; tried:\n{lines}"
+        f"PETSc: {describe(last.reason)}; remedy: {fix}\ntried:\n{lines}"
     )
     details = {
         "load_factor": lam,
