@@ -33,6 +33,7 @@ class CampbellResult(NamedTuple):
     stable: np.ndarray  # (speeds,): no mode grows
     steady: tuple  # StaticResult per speed
     stopped_by: str | None  # why the sweep ended early (no steady state), else None
+    failure: Exception | None = None  # a numerical failure that ended the sweep (SolveFailed)
 
 
 def track(previous, candidates, M):
@@ -57,23 +58,29 @@ def campbell(
     frequency rises past another one's is still found. A speed where no steady state is found
     (:func:`~beamfx.analyses.rotating.solve_steady`) ends the sweep; ``stopped_by`` says why.
     ``on_speed(i, speed)`` is called with the model at each steady state reached (i from 1).
+    A numerical failure (Newton or an eigen solve) also ends it; ``failure`` holds it.
     """
     from ..solvers.snes import SolveFailed
+    from .rotating_checks import NoSteadyState
 
     model = frame.model
     done, freq, b_hz, b_growth, b_mac, b_out, stable, steady = ([] for _ in range(8))
-    shapes, stopped_by = None, None
+    shapes, stopped_by, failure = None, None, None
     for speed in speeds:
         try:
             steady.append(solve_steady(frame, speed, steps=steps, options=options))
+            if on_speed:
+                on_speed(len(steady), speed)
+            modes = solve_rotating_modes(frame, n_modes + extra_modes, options=options)
         except SolveFailed as e:
-            stopped_by = str(e).splitlines()[0]
+            if isinstance(e, NoSteadyState):
+                stopped_by = str(e).splitlines()[0]
+            else:
+                failure = e
             if log:
-                log(f"  {speed:.6g} rad/s: {stopped_by}")
+                log(f"  {speed:.6g} rad/s: {str(e).splitlines()[0]}")
+            steady = steady[: len(done)]
             break
-        if on_speed:
-            on_speed(len(steady), speed)
-        modes = solve_rotating_modes(frame, n_modes + extra_modes, options=options)
         if shapes is None:
             order, mac = np.arange(n_modes), np.ones(n_modes)
         else:
@@ -106,6 +113,7 @@ def campbell(
         np.array(stable, dtype=bool),
         tuple(steady),
         stopped_by,
+        failure,
     )
 
 

@@ -153,13 +153,16 @@ def solve_steady(frame, speed, steps=10, options=None, prefix="beamfx_rotating_s
     factor 1.
 
     Raises:
-        SolveFailed: if a step does not converge, or if the state reached has a folded centre
-            line (axial stretch ≤ 0 somewhere). Both happen beyond a divergence speed, where no
-            steady state is left: for a linear-elastic radial rod the centrifugal stretch grows
-            without bound as Ω → (π/2) sqrt(E/ρ)/L, and past it the load steps can jump to a
-            folded, unstable solution of the equations.
+        NoSteadyState: past a divergence speed, where no steady state is left: the state
+            reached has a folded centre line (axial stretch ≤ 0 somewhere), or Newton failed
+            and the tangent loses definiteness by this speed
+            (:func:`~beamfx.analyses.rotating_checks.steady_state_lost`). For a linear-elastic
+            radial rod the centrifugal stretch grows without bound as Ω → (π/2) sqrt(E/ρ)/L,
+            and past it the load steps can jump to a folded, unstable solution.
+        SolveFailed: Newton failed with the tangent positive definite (numerical).
     """
     from ..solvers.snes import SolveFailed
+    from .rotating_checks import NoSteadyState, classify_failure
 
     model = frame.model
     frame.set_speed(speed)
@@ -169,13 +172,17 @@ def solve_steady(frame, speed, steps=10, options=None, prefix="beamfx_rotating_s
     if load_scale(model, solver.F) == 0.0:  # at rest and unloaded: the reference state (Newton
         model.set_load_factor(1.0)  # could not reach an absolute tolerance of 0)
         return StaticResult((), 0, {"total": 0.0})
-    result = solve_static(model, steps=steps, solver=solver, log=log)
+    try:
+        result = solve_static(model, steps=steps, solver=solver, log=log)
+    except SolveFailed as e:
+        raise classify_failure(frame, e) from None
     stretch = frame.min_stretch()
     if stretch <= 0:
-        raise SolveFailed(
+        raise NoSteadyState(
             f"no steady state at {speed:.6g} rad/s: the equilibrium found has a folded centre "
             f"line (smallest axial stretch {stretch:.3g}); the speed is past a divergence",
             result.steps,
+            "no steady state",
         )
     return result
 
@@ -241,7 +248,15 @@ def solve_rotating_modes(frame, n_modes=6, options=None, prefix="beamfx_rotating
     keep.sort(key=lambda i: (abs(pairs.values[i].imag), -pairs.values[i].real))
     keep = keep[:n_modes]
     if len(keep) < n_modes:
-        raise RuntimeError(f"only {len(keep)} of {n_modes} modes found ({prefix})")
+        from ..solvers.snes import SolveFailed
+
+        raise SolveFailed(
+            f"eigen solve ({prefix}): only {len(keep)} of {n_modes} modes found among "
+            f"{len(pairs.values)} eigenvalues; cause: eigen solve; remedy: ask for fewer modes",
+            cause="eigen solve",
+            remedy="ask for fewer modes ([analysis] modes)",
+            details={"requested": n_modes, "converged": len(keep)},
+        )
     lam = pairs.values[keep]
     omega = np.abs(lam.imag)
     return RotatingModes(

@@ -68,7 +68,7 @@ class Result(_Base):
     frequencies_hz: tuple = entry("rotating-frame frequencies per speed")
     stable: tuple = entry("whether each steady state is stable")
     campbell: tuple = entry("branches followed across speeds (frequency, growth, MAC)")
-    stopped_by: str | None = entry("why the sweep of speeds ended early, or None")
+    stopped_by: str | None = entry("why the sweep of speeds ended early (a lost steady state)")
     files: dict = entry("campbell.csv and campbell.png")
     steady_newton_iterations: tuple = entry("Newton iterations of each steady state")
 
@@ -115,10 +115,15 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     frame.destroy()
     write_campbell(result, ctx.folder, model.comm)
     steps = result.steady[-1].steps if result.steady else ()
+    failure = result.failure  # numerical: "failed"; a lost steady state: "stopped"
+    status = "failed" if failure else "stopped" if result.stopped_by else "converged"
     return Result(
         analysis=ctx.analysis,
-        status="converged" if result.stopped_by is None else "stopped",
-        reason=result.stopped_by,
+        status=status,
+        reason=str(failure).splitlines()[0] if failure else result.stopped_by,
+        cause=getattr(failure, "cause", None),
+        remedy=getattr(failure, "remedy", None),
+        failure=dict(getattr(failure, "details", None) or {}) or None,
         load_steps=tuple(steps),
         newton_iterations=int(sum(s.iterations for s in steps)),
         seconds={"total": float(sum(s.seconds["total"] for s in result.steady))},

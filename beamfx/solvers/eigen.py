@@ -32,20 +32,46 @@ class EigenPairs(NamedTuple):
     seconds: float
 
 
+def _reason_name(solver):
+    """The SLEPc name of the solver's converged reason (EPS or PEP)."""
+    code = solver.getConvergedReason()
+    names = vars(type(solver).ConvergedReason)
+    return next((k for k, v in names.items() if v == code and not k.startswith("_")), str(code))
+
+
+def _too_few(solver, n, nev, prefix):
+    """The :class:`~beamfx.solvers.snes.SolveFailed` of a solve that converged ``n`` < ``nev``
+    pairs, with the values it got; the solver is destroyed."""
+    from .snes import SolveFailed
+
+    got = [complex(solver.getEigenvalue(i)) for i in range(n)]
+    reason, its = _reason_name(solver), solver.getIterationNumber()
+    solver.destroy()
+    values = [v.real if v.imag == 0 else [v.real, v.imag] for v in got]
+    return SolveFailed(
+        f"eigen solve ({prefix}): {n} of {nev} eigenpairs converged after {its} iterations "
+        f"(SLEPc {reason}); cause: eigen solve; remedy: ask for fewer modes (the model may have fewer than asked: refine it) or give SLEPc more "
+        "iterations ([solver] eps_max_it, default 200)",
+        cause="eigen solve",
+        remedy="ask for fewer modes ([analysis] modes) or give SLEPc more iterations "
+        "([solver] eps_max_it, default 200)",
+        details={"requested": nev, "converged": n, "eigenvalues": values, "reason": reason},
+    )
+
+
 def solve_and_collect(solver, A, nev, prefix, keep):
     """Run a configured SLEPc EPS or PEP ``solver`` (operators of the size of ``A``), check
     that ``nev`` pairs converged, and return (values, [keep(vr, vi) per pair], errors,
     iterations); the solver is destroyed.
 
     Raises:
-        RuntimeError: if fewer than ``nev`` pairs converged.
+        SolveFailed: if fewer than ``nev`` pairs converged (cause "eigen solve"; ``details``
+            holds the eigenvalues it found).
     """
     solver.solve()
     n = solver.getConverged()
     if n < nev:
-        reason = solver.getConvergedReason()
-        solver.destroy()
-        raise RuntimeError(f"SLEPc ({prefix}): {n} of {nev} eigenpairs converged, reason {reason}")
+        raise _too_few(solver, n, nev, prefix)
     values, vectors, errors = [], [], []
     vr, vi = A.createVecs()
     for i in range(n):
@@ -72,7 +98,7 @@ def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=N
         shift: shift of the spectral transform; None: ``target``.
 
     Raises:
-        RuntimeError: if fewer than ``nev`` pairs converged.
+        SolveFailed: if fewer than ``nev`` pairs converged.
     """
     from slepc4py import SLEPc
 

@@ -73,7 +73,7 @@ def solve_quadratic(K, G, M, nev, target, prefix, options=None, scale=None):
         :class:`QuadraticPairs`; in real arithmetic a complex λ comes with its conjugate.
 
     Raises:
-        RuntimeError: if fewer than ``nev`` pairs converged.
+        SolveFailed: if fewer than ``nev`` pairs converged.
     """
     from slepc4py import SLEPc
 

@@ -1,0 +1,83 @@
+"""Physical tests of a rotating steady state: whether a failed steady-state solve lost the
+steady state (a divergence speed passed: a physical stop) or failed numerically.
+
+Newton failing is not evidence of a physical stop. The test here is the tangent of the
+relative equilibrium, K_T(Ω²) (elastic, geometric and spin-softening stiffness): a steady state
+exists and is statically stable while K_T is positive definite; at a divergence speed its
+lowest eigenvalue μ (of K_T v = μ M v) crosses zero. After a failure the last converged state
+of the Ω² ramp, at load factor λ_n, is tested: μ_n ≤ 0, or μ falling from its value at rest
+so that its linear extrapolation in Ω² reaches zero by the asked speed (λ ≤ 1), is a loss of
+steady state; otherwise the failure is numerical.
+"""
+
+import numpy as np
+
+from ..solvers.snes import SolveFailed
+
+
+class NoSteadyState(SolveFailed):
+    """No steady state at the asked speed (a physical stop: a divergence speed passed)."""
+
+
+def lowest_tangent_eigenvalue(frame, prefix="beamfx_rotating_check_"):
+    """μ of K_T v = μ M v nearest 0 about the model's current state and load factor."""
+    from ..solvers.eigen import solve_eigen
+    from .rotating import assemble_operators
+
+    K, G, M = assemble_operators(frame)
+    try:
+        pairs = solve_eigen(K, M, 1, 0.0, prefix, hermitian=False)
+    finally:
+        for A in (K, G, M):
+            A.destroy()
+    for x in pairs.vectors:
+        x.destroy()
+    return float(pairs.values[0].real)
+
+
+def steady_state_lost(frame, lam_last):
+    """(lost, why) after a failed Ω² ramp whose last converged load factor is ``lam_last`` (the
+    model holds that state). The model is left as it was."""
+    model, speed = frame.model, frame.speed
+    saved, lam_now = model.w.x.array.copy(), float(model.load_factor.value)
+    model.set_load_factor(lam_last)
+    mu_last = lowest_tangent_eigenvalue(frame)
+    model.reset()
+    model.set_load_factor(0.0)
+    mu_0 = lowest_tangent_eigenvalue(frame)
+    model.w.x.array[:] = saved
+    model.w.x.scatter_forward()
+    model.set_load_factor(lam_now)
+    at = f"{np.sqrt(lam_last) * speed:.6g} rad/s"
+    numbers = f"lowest tangent eigenvalue {mu_0:.4g} at rest, {mu_last:.4g} at {at}"
+    if mu_last <= 0:
+        return True, f"the tangent is not positive definite at {at} ({numbers})"
+    if lam_last > 0 and mu_last < mu_0:
+        lam_zero = lam_last * mu_0 / (mu_0 - mu_last)
+        if lam_zero <= 1.0:
+            return True, (
+                f"the tangent loses definiteness near {np.sqrt(lam_zero) * speed:.6g} rad/s, "
+                f"below the asked speed ({numbers}; extrapolated in Ω²)"
+            )
+    return False, f"the tangent stays positive definite ({numbers})"
+
+
+def classify_failure(frame, error):
+    """The exception to raise for a failed steady state at the frame's speed: a
+    :class:`NoSteadyState` if :func:`steady_state_lost`, else ``error`` (a numerical failure)
+    with the tangent's verdict added to its message and details."""
+    steps = getattr(error, "history", ())
+    lam_last = steps[-1].load_factor if steps else 0.0
+    lost, why = steady_state_lost(frame, lam_last)
+    speed = f"{frame.speed:.6g} rad/s"
+    if lost:
+        return NoSteadyState(f"no steady state at {speed}: {why}", steps, "no steady state")
+    first, _, rest = str(error).partition("\n")
+    return SolveFailed(
+        f"numerical failure of the steady state at {speed} ({why}): {first}"
+        + (f"\n{rest}" if rest else ""),
+        steps,
+        getattr(error, "cause", None),
+        getattr(error, "remedy", None),
+        {**getattr(error, "details", {}), "tangent": why},
+    )
