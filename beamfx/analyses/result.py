@@ -70,6 +70,7 @@ class Result:
                 "residuals": list(s.residuals),
                 "cutbacks": s.cutbacks,
                 "converged_by": getattr(s, "converged_by", "residual"),
+                "force_scale": getattr(s, "force_scale", 0.0),
             }
             for s in self.load_steps
         ]

@@ -10,9 +10,10 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
 * **residual**: ‖F‖ ≤ max(atol, 1e-10·S), S the force scale of the model: the load norm given
   by the analysis or the norm of the reactions (the internal force at the supports), the
   larger;
-* **floor**: ‖F‖ ≤ :data:`FLOOR_LIMIT`·S and ‖F‖ ≤ :data:`FLOOR_FACTOR` × the round-off floor ε‖ |K| (|x| + s) ‖ (|K| the
+* **floor**: ‖F‖ ≤ :data:`FLOOR_FACTOR` × the round-off floor ε‖ |K| (|x| + s) ‖ (|K| the
   tangent's entries in absolute value, s a size per unknown added to the state, e.g. the
-  element length for displacements, so that the terms of the reference geometry count)
+  element length for displacements, so that the terms of the reference geometry count), and
+  ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too),
   *and* the increment criteria hold: the last correction is small against the state,
   ‖du‖ ≤ :data:`INCREMENT_TOL`·‖x‖, and its energy is small, |du·F| ≤ :data:`ENERGY_TOL`·E
   with E the larger of the solve's largest correction energy and the state's |x·Kx|;
@@ -158,7 +159,9 @@ class ScaledTest:
         if self.floor is None:  # once per solve: the tangent hardly changes at this stage
             self.floor = self.absolute.floor(s.A, snes.getSolution(), s.sizes)
         record["floor"] = self.floor
-        if fnorm <= FLOOR_FACTOR * self.floor and fnorm <= FLOOR_LIMIT * scale:
+        # with no load, the reactions are round-off too: nothing to resolve beyond the floor
+        unloaded = s.force_scale == 0.0 and scale <= FLOOR_FACTOR * self.floor
+        if fnorm <= FLOOR_FACTOR * self.floor and (fnorm <= FLOOR_LIMIT * scale or unloaded):
             self.how = "floor"
             return reason.CONVERGED_SNORM_RELATIVE
         return reason.CONVERGED_ITERATING

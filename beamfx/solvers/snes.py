@@ -57,6 +57,7 @@ class SolveReport(NamedTuple):
     cause: str | None = None  # why it failed (convergence.REMEDIES' keys)
     detail: str | None = None  # the numbers behind the cause
     floor: float | None = None  # the round-off floor estimate at the last iterate, if known
+    scale: float = 0.0  # the force scale S of the last iterate (load or reactions)
 
 
 class SolveFailed(RuntimeError):
@@ -181,6 +182,7 @@ class NewtonSolver:
                 tuple(self._residuals),
                 seconds,
                 criterion=self.test.how,
+                scale=self.test.records[-1]["scale"],
             )
         floor = self.test.absolute.floor(self.A, self.x, self.sizes)
         cause, detail = diagnose(reason, self.test.records, floor)

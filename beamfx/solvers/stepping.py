@@ -31,6 +31,7 @@ class LoadStep(NamedTuple):
     residuals: tuple
     cutbacks: int
     converged_by: str = "residual"  # the criterion that held: 'residual', 'floor', 'relative'
+    force_scale: float = 0.0  # what the residual was measured against (load or reactions)
 
 
 def step_load(
@@ -83,6 +84,7 @@ def step_load(
                 report.residuals,
                 len(tried),
                 report.criterion or "residual",
+                report.scale,
             )
             history.append(item)
             if log:
