@@ -111,6 +111,7 @@ class AbsoluteTangent:
         return float(np.finfo(float).eps * self.out.norm())
 
     def destroy(self):
+        """Free the PETSc objects."""
         for obj in (self.B, self.v, self.out):
             obj.destroy()
 
@@ -127,10 +128,12 @@ class ScaledTest:
         self.reset()
 
     def reset(self):
+        """Forget the last solve (called before each)."""
         self.records, self.how = [], None
         self.first_energy, self.state_energy, self.floor = 0.0, None, None
 
     def __call__(self, snes, it, norms):
+        """PETSc's reason after iteration ``it`` (norms: ‖x‖, ‖du‖, ‖F‖); ITERATING to go on."""
         from petsc4py import PETSc
 
         reason = PETSc.SNES.ConvergedReason
@@ -179,6 +182,7 @@ class ScaledTest:
         return record["energy"] <= ENERGY_TOL * record["reference"]
 
     def destroy(self):
+        """Free the PETSc objects."""
         self.absolute.destroy()
         self.F_prev.destroy()
         self.Kx.destroy()
