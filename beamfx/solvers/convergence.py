@@ -169,6 +169,18 @@ class ScaledTest:
             return reason.CONVERGED_SNORM_RELATIVE
         return reason.CONVERGED_ITERATING
 
+    def linear(self, x, fnorm):
+        """The test after one linear solve (``snes_type ksponly``): the residual criterion, or
+        the floor without the increment criteria (the solve is exact but for round-off)."""
+        s = self.solver
+        scale = max(s.force_scale, s.reactions)
+        self.records.append({"fnorm": fnorm, "step": 0.0, "state": 0.0, "scale": scale})
+        self.floor = self.absolute.floor(s.A, x, s.sizes)
+        if fnorm <= max(s.atol, RESIDUAL_TOL * scale):
+            self.how = "residual"
+        elif fnorm <= FLOOR_FACTOR * self.floor:
+            self.how = "floor"
+
     def increment_small(self, record, x):
         """The increment criteria of the last iteration: ‖du‖ ≤ INCREMENT_TOL·‖x‖ and
         |du·F| ≤ ENERGY_TOL·E, E the larger of the solve's largest correction energy and the
