@@ -335,7 +335,6 @@ def _check_points(model, probes, file, loads):
 
 def _check_orientation(beam, where):
     """The reference vector must not be parallel to the centre line anywhere."""
-
     if beam.orientation is None:
         return
     s = np.linspace(0, beam.curve.length, 201)
