@@ -93,6 +93,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         point_masses=tuple(masses),
     )
     _check_points(model, probes, file, data.get("loads", []))
+    _check_histories(model, settings, file, data.get("loads", []))
     if not model.supports and not getattr(settings, "free_body", lambda m: False)(model):
         raise SceneError(
             f"{file}: supports: none given; the structure is free (rigid-body motion), which "
@@ -309,14 +310,42 @@ def _check_model(model, file):
             )
 
 
+def _load_indices(loads):
+    """Indices in ``[[loads]]`` of the point loads and of the distributed loads, in order."""
+    at_load = [i for i, t in enumerate(loads) if "gravity" not in t and "at" in t]
+    on_beam = [i for i, t in enumerate(loads) if "gravity" not in t and "at" not in t]
+    return at_load, on_beam
+
+
+def _check_histories(model, settings, file, loads):
+    """Every load and support history finite over the whole run (``[0, t_end]`` of a
+    transient; the reader checked ``[0, 1]``)."""
+    t_end = getattr(settings, "t_end", None)
+    if t_end is None:
+        return
+    at_load, on_beam = _load_indices(loads)
+    timed = [(f"loads[{i}]", p) for i, p in zip(at_load, model.point_loads)]
+    timed += [(f"loads[{i}]", d) for i, d in zip(on_beam, model.distributed_loads)]
+    timed += [(f"supports[{i}]", s) for i, s in enumerate(model.supports)]
+    t = np.linspace(0.0, t_end, 1001)
+    for where, item in timed:
+        if item.history is not None:
+            with np.errstate(all="ignore"):
+                values = np.asarray(item.history(t), float)
+            if not np.all(np.isfinite(values)):
+                bad = float(t[~np.isfinite(values)][0])
+                raise SceneError(
+                    f"{file}: {where}.history: not finite at t = {bad:g} (within [0, t_end]); "
+                    "allowed: a function finite over the whole run"
+                )
+
+
 def _check_points(model, probes, file, loads):
     """Every named point on a beam, every load's beam a beam (``loads``: the scene's
     ``[[loads]]`` tables, for the index of each load in the messages)."""
     from ..spec import resolve_point
 
-    loads = [t for t in loads if isinstance(t, dict)]
-    at_load = [i for i, t in enumerate(loads) if "gravity" not in t and "at" in t]
-    on_beam = [i for i, t in enumerate(loads) if "gravity" not in t and "at" not in t]
+    at_load, on_beam = _load_indices(loads)
     named = [(f"supports[{i}].at", s.at) for i, s in enumerate(model.supports)]
     named += [(f"loads[{i}].at", p.at) for i, p in zip(at_load, model.point_loads)]
     named += [(f"springs[{i}].at", s.at) for i, s in enumerate(model.springs)]

@@ -473,6 +473,14 @@ SIZES = [
     ),
     (lambda d: d.update(limits={"max_unknowns": math.nan}), "limits.max_unknowns", "integer"),
     (
+        lambda d: (
+            d.update(analysis=ANALYSES["transient"])
+            or d["loads"][0].update(history="1 / (t - 0.75)")
+        ),
+        "loads[0].history",
+        "not finite at t = 0.75",
+    ),
+    (
         lambda d: d["beams"].extend({**d["beams"][0], "name": f"b{i}"} for i in range(5000)),
         "beams",
         "max_beams",
