@@ -38,7 +38,7 @@ def _convert(spec, value, fail):
         return value
     if kind is float:
         if not is_number(value):
-            fail(f"= {value!r}: {bad}" if _number(value) else bad)
+            fail(f"= {value!r}: must be a finite {describe(spec)}" if _number(value) else bad)
         return float(value)
     if kind == tuple[str, ...]:
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
