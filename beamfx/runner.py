@@ -279,14 +279,18 @@ def _finish(run, out, scene, refinement, log, comm, png, animate):
 
 
 def check_scene(path: str | os.PathLike) -> "Scene | Sweep":
-    """Validate a scene without solving: keys, types, points, supports; for a sweep file every
-    member. Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
+    """Validate a scene without solving: keys, types, points, supports; for a sweep file the
+    members validated on reading (:mod:`beamfx.scene.sweep`). Returns the scene, or the
+    :class:`~beamfx.scene.Sweep`."""
     from .analyses.checks import check_supports_for
     from .io.folder import check_output_dir
-    from .scene import Sweep, load_scene_or_sweep
+    from .scene import SceneError, Sweep, load_scene_or_sweep
 
     loaded = load_scene_or_sweep(path)
-    for scene in [m.scene for m in loaded.members] if isinstance(loaded, Sweep) else [loaded]:
-        check_supports_for(scene.model, scene.settings)
+    for scene in loaded.validated if isinstance(loaded, Sweep) else [loaded]:
+        try:
+            check_supports_for(scene.model, scene.settings)
+        except ValueError as e:
+            raise SceneError(f"{scene.file}: supports: {e}") from None
     check_output_dir(loaded.output_dir, str(path))
     return loaded

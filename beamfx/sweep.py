@@ -42,6 +42,7 @@ def summary(run):
 
 
 def _solve_member(member, folder, comm, log, run_scene, **options):
+    from .scene import SceneError
     from .solvers import SolveFailed
 
     t0 = time.perf_counter()
@@ -53,7 +54,7 @@ def _solve_member(member, folder, comm, log, run_scene, **options):
         row.update(status=results.result.status, **summary(results))
         if results.result.reason is not None:  # stopped before the end (sweep.md says why)
             row["reason"] = results.result.reason
-    except SolveFailed as e:
+    except (SolveFailed, SceneError) as e:  # a member's values may clash (built lazily)
         row.update(status="failed", reason=str(e))
     row["wall_s"] = time.perf_counter() - t0
     row["folder"] = folder.name

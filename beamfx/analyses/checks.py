@@ -29,29 +29,41 @@ def model_size(model):
 
 def closest_arc_length(curve, x, samples=400):
     """Arc length of the point of ``curve`` closest to ``x``, and the distance."""
-    s = np.linspace(0.0, curve.length, samples + 1)
-    i = int(np.argmin(np.linalg.norm(curve.points(s) - x, axis=1)))
-    a, b = s[max(i - 1, 0)], s[min(i + 1, samples)]
-    for _ in range(80):  # golden-section search in the bracketing interval
-        c, d = b - 0.618 * (b - a), a + 0.618 * (b - a)
-        fc, fd = (np.linalg.norm(curve.points([t])[0] - x) for t in (c, d))
-        a, b = (a, d) if fc < fd else (c, b)
-    t = (a + b) / 2
-    return t, float(np.linalg.norm(curve.points([t])[0] - x))
+    a, b, n = 0.0, curve.length, samples
+    for _ in range(8):  # sample, bracket the nearest sample, refine: 16x narrower per pass
+        s = np.linspace(a, b, n + 1)
+        dist = np.linalg.norm(curve.points(s) - x, axis=1)
+        i = int(np.argmin(dist))
+        a, b, n = s[max(i - 1, 0)], s[min(i + 1, n)], 32
+    return float(s[i]), float(dist[i])
 
 
 def end_contacts(model, rtol=1e-8):
     """(i, j, s): the end of beam i lies on beam j at its arc length s (to rtol of the model)."""
     tol = rtol * model_size(model)
+    lo, hi = _boxes(model, tol)
     out = []
     for i, a in enumerate(model.beams):
         for x in a.curve.points([0.0, a.curve.length]):
-            for j, b in enumerate(model.beams):
-                if j != i:
-                    s, dist = closest_arc_length(b.curve, x)
-                    if dist < tol:
-                        out.append((i, j, s))
+            near = np.flatnonzero(np.all((lo <= x) & (x <= hi), axis=1))  # boxes holding x
+            for j in near[near != i]:
+                s, dist = closest_arc_length(model.beams[j].curve, x)
+                if dist < tol:
+                    out.append((i, int(j), s))
     return out
+
+
+def _boxes(model, tol, samples=64):
+    """(lo, hi): boxes around each beam, (n_beams, 3) each. Every point of a curve lies
+    within L/samples (arc length) of a sample, so the samples' box padded by that holds it;
+    an end point outside a beam's box is farther than ``tol`` from the beam."""
+    lo, hi = [], []
+    for b in model.beams:
+        x = b.curve.points(np.linspace(0.0, b.curve.length, samples + 1))
+        pad = b.curve.length / samples + tol
+        lo.append(x.min(axis=0) - pad)
+        hi.append(x.max(axis=0) + pad)
+    return np.array(lo), np.array(hi)
 
 
 def joint_breaks(model, rtol=1e-8):

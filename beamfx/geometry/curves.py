@@ -193,34 +193,78 @@ class SampledCurve:
         return spline(p_of_s(np.atleast_1d(s)))
 
 
+def _quiet_fltk():
+    """Stop FLTK (linked into gmsh) from rewriting its preference files.
+
+    ``gmsh.initialize`` sets the default of ``General.Tooltips`` with ``Fl::option``, whose
+    first call reads *and rewrites* ``/etc/fltk/fltk.org/fltk.prefs`` and
+    ``~/.fltk/fltk.org/fltk.prefs`` (as root, both). Marking FLTK's options as already read
+    (its static ``Fl::options_read_``) skips that: the options keep FLTK's built-in defaults,
+    which a run without a window never uses. Where FLTK is not found, nothing is done.
+    """
+    import ctypes
+
+    for name in ("libfltk.so.1.3", "libfltk.so"):
+        try:
+            ctypes.c_uint8.in_dll(ctypes.CDLL(name), "_ZN2Fl13options_read_E").value = 1
+            return
+        except (OSError, ValueError):
+            continue
+
+
 def curve_from_gmsh(path, curve_tag=None, samples=400):
     """The curve of a gmsh ``.geo`` or ``.msh`` file, as a :class:`SampledCurve`.
 
     With several curves, ``curve_tag`` picks one; consecutive curves of a ``.geo`` are not
-    joined: describe each as its own beam sharing end points.
+    joined: describe each as its own beam sharing end points. A ``.geo`` file is scanned first
+    (:func:`~beamfx.geometry.geo_scan.check_geo`: plain geometry only, nothing that runs,
+    writes, reads or loops); gmsh reads no configuration file and writes no preference file.
+
+    Raises:
+        ValueError: naming the file, for a refused or unreadable file.
     """
     import gmsh
 
-    gmsh.initialize()
+    from .geo_scan import check_geo
+
+    path = str(path)
+    if path.lower().endswith(".geo"):
+        with open(path, encoding="utf-8", errors="strict") as f:
+            check_geo(f.read())
+    _quiet_fltk()
+    gmsh.initialize(readConfigFiles=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(str(path))
-        curves = [tag for dim, tag in gmsh.model.getEntities(1)]
-        if not curves:
-            raise ValueError(f"{path}: no curve (1D entity) in the file")
-        if curve_tag is None:
-            if len(curves) > 1:
-                raise ValueError(f"{path}: {len(curves)} curves {curves}; give curve_tag")
-            curve_tag = curves[0]
-        if curve_tag not in curves:
-            raise ValueError(f"{path}: curve_tag {curve_tag} not in {curves}")
-        lo, hi = gmsh.model.getParametrizationBounds(1, curve_tag)
-        u = np.linspace(lo[0], hi[0], samples)
-        xyz = np.reshape(gmsh.model.getValue(1, curve_tag, u), (-1, 3))
-        if np.allclose(xyz, xyz[0]):
-            # discrete curve from a .msh: use its mesh nodes in order
-            _, coords, _ = gmsh.model.mesh.getNodes(1, curve_tag, includeBoundary=True)
-            xyz = np.reshape(coords, (-1, 3))
+        gmsh.option.setString("General.TmpFileName", "")  # nothing to remove in the home folder
+        gmsh.open(path)
+        xyz = _gmsh_curve_points(gmsh, path, curve_tag, samples)
+    except Exception as e:  # gmsh raises a bare Exception with its last error message
+        if isinstance(e, ValueError):
+            raise
+        raise ValueError(f"{path}: gmsh could not read it: {e}") from None
     finally:
         gmsh.finalize()
     return SampledCurve(tuple(map(tuple, xyz)))
+
+
+def _gmsh_curve_points(gmsh, path, curve_tag, samples):
+    """Points along the chosen 1D entity of the open gmsh model."""
+    curves = [tag for dim, tag in gmsh.model.getEntities(1)]
+    if not curves:
+        raise ValueError(f"{path}: no curve (1D entity) in the file")
+    if curve_tag is None:
+        if len(curves) > 1:
+            raise ValueError(f"{path}: {len(curves)} curves {curves}; give curve_tag")
+        curve_tag = curves[0]
+    if curve_tag not in curves:
+        raise ValueError(f"{path}: curve_tag {curve_tag} not in {curves}")
+    lo, hi = gmsh.model.getParametrizationBounds(1, curve_tag)
+    u = np.linspace(lo[0], hi[0], samples)
+    xyz = np.reshape(gmsh.model.getValue(1, curve_tag, u), (-1, 3))
+    if np.allclose(xyz, xyz[0]):
+        # discrete curve from a .msh: use its mesh nodes in order
+        _, coords, _ = gmsh.model.mesh.getNodes(1, curve_tag, includeBoundary=True)
+        xyz = np.reshape(coords, (-1, 3))
+    if not np.all(np.isfinite(xyz)) or len(xyz) < 2:
+        raise ValueError(f"{path}: curve {curve_tag} has no finite points")
+    return xyz

@@ -77,6 +77,39 @@ def _nodes_and_cells(specs, degree, tol):
     return np.array(pts, float), np.array(cells, np.int64), np.array(beam_of), np.array(spans)
 
 
+def tolerance(specs):
+    """The distance under which two mesh vertices are one (1e-9 of the model's size)."""
+    size = max(np.ptp(np.vstack([s.curve.points([0, s.curve.length]) for s in specs])), 1.0)
+    return 1e-9 * size
+
+
+def overlapping_cells(specs):
+    """(index of the spec, why) if the element vertices of ``specs`` would make a broken
+    mesh, or None.
+
+    Vertices closer than :func:`tolerance` are merged (that is how beams share a joint, and a
+    closed curve closes). A curve that runs over itself (an arc of 720°) would then give two
+    cells on the same two vertices, or a cell whose two ends are one vertex.
+    """
+    tol = tolerance(specs)
+    ids, seen = {}, {}
+    for index, spec in enumerate(specs):
+        s_v = _element_breaks(spec)
+        keys = np.round(np.asarray(spec.curve.points(s_v), float) / tol).astype(np.int64)
+        v = [ids.setdefault(tuple(k), len(ids)) for k in keys]
+        for i, (a, b) in enumerate(pairwise(v)):
+            where = f"beam {spec.name!r}, element {i} (arc length {s_v[i]:.6g} to {s_v[i + 1]:.6g})"
+            if a == b:
+                return index, f"{where} has both ends at one point: elements shorter than {tol:.1e}"
+            other = seen.setdefault((min(a, b), max(a, b)), where)
+            if other != where:
+                return index, (
+                    f"{where} lies on {other} (the same two end points): the curve runs over "
+                    "itself, or two one-element beams join the same points (give more elements)"
+                )
+    return None
+
+
 def build_mesh(comm, specs, degree, named_points=None):
     """Mesh of all beams with isoparametric P_degree geometry on the exact curves.
 
@@ -93,8 +126,12 @@ def build_mesh(comm, specs, degree, named_points=None):
     import ufl
     from mpi4py import MPI
 
-    size = max(np.ptp(np.vstack([s.curve.points([0, s.curve.length]) for s in specs])), 1.0)
-    tol = 1e-9 * size
+    tol = tolerance(specs)
+    # a curve over itself gives duplicated cells, on which DOLFINx's topology aborts the
+    # process (munmap_chunk, SIGABRT) or fails on some ranks only: refuse it on every rank
+    problem = comm.bcast(overlapping_cells(specs) if comm.rank == 0 else None, root=0)
+    if problem:
+        raise ValueError(problem[1])
     if comm.rank == 0:
         x, cells, beam_of, spans = _nodes_and_cells(specs, degree, tol)
     else:

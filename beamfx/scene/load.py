@@ -5,37 +5,21 @@ The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, `
 """
 
 import os
-import tomllib
 from dataclasses import dataclass, field
-from functools import partial
-from numbers import Real
 from pathlib import Path
 
 import numpy as np
 
 from ..analyses.trimming import PLANE_CHOICES
-from ..geometry import curves
-from ..physics import sections
 from ..physics.kinematics import PLANES, Kinematics
 from ..solvers.options import option_problems
-from ..spec import (
-    AXES,
-    DOF_NAMES,
-    LOAD_KINDS,
-    Beam,
-    DistributedLoad,
-    Model,
-    PointLoad,
-    PointMass,
-    Spring,
-    Support,
-)
-from .expr import compile_expression, table_function
+from ..spec import Beam, Model
+from .curve import overlap, read_curve
+from .files import read_toml
+from .limits import read_limits, unknowns
+from .loads import read_loads, read_masses, read_springs, read_supports
+from .section import read_material, read_section
 from .table import SceneError, Table
-
-CURVE_SHAPES = ("line", "arc", "helix", "polyline", "spline", "gmsh")
-SECTION_TYPES = ("rectangle", "circle", "tube", "general")
-FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
 
 
 @dataclass(frozen=True)
@@ -74,266 +58,24 @@ class Scene:
         return getattr(self.settings, "steps", 10)
 
 
-def _curve(t, base):
-    shape = t.get("shape", str, choices=CURVE_SHAPES)
-    if shape == "line":
-        start = t.get("start", "vec3")
-        if t.has("end"):
-            end = t.get("end", "vec3")
-        else:
-            d, L = t.get("direction", "vec3"), t.get("length", float, positive=True)
-            n = sum(x * x for x in d) ** 0.5 or t.fail("direction", "must not be zero")
-            end = tuple(s + L * x / n for s, x in zip(start, d))
-        c = curves.Line(start, end)
-    elif shape == "arc":
-        c = curves.Arc(
-            t.get("start", "vec3"),
-            t.get("start_tangent", "vec3"),
-            t.get("centre", "vec3"),
-            t.get("angle_deg", float, positive=True),
-        )
-        if c.radius == 0:
-            t.fail("centre", "must differ from start (zero radius)")
-    elif shape == "helix":
-        c = curves.Helix(
-            t.get("centre", "vec3"),
-            t.get("axis", "vec3"),
-            t.get("radius", float, positive=True),
-            t.get("pitch", float),
-            t.get("turns", float, positive=True),
-            t.get("start_direction", "vec3", (1.0, 0.0, 0.0)),
-        )
-    elif shape in ("polyline", "spline"):
-        pts = t.get("points", list)
-        if len(pts) < 2 or not all(isinstance(p, list) and len(p) == 3 for p in pts):
-            t.fail("points", "expected a list of at least two [x, y, z] points")
-        pts = tuple(tuple(float(x) for x in p) for p in pts)
-        c = curves.Polyline(pts) if shape == "polyline" else curves.SampledCurve(pts)
-    else:
-        f = base / t.get("file", str)
-        if not f.exists():
-            t.fail("file", f"no such file: {f}")
-        c = curves.curve_from_gmsh(f, t.get("curve_tag", int, None))
-    t.done()
-    if not c.length > 0:
-        raise SceneError(f"{t.where('')[:-1]}: zero-length curve")
-    return c
-
-
-def _along(t, key, length, default=..., positive=True):
-    """A section value: a number, an expression of the arc length ``s`` (and the beam length
-    ``L``), or a table ``{ s = [...], values = [...] }``; checked positive along the beam."""
-    if not t.has(key) and default is not ...:
-        t.get(key, float, default)
-        return default
-    raw = t.data.get(key)
-    if isinstance(raw, (str, dict)):
-        t.used.add(key)
-        try:
-            if isinstance(raw, str):
-                f = compile_expression(raw, "s", {"L": length})
-            else:
-                sub = Table(raw, t.path + "." + key, t.file)
-                f = table_function(sub.get("s", list), sub.get("values", list))
-                sub.done()
-            values = f(np.linspace(0.0, length, 201))
-        except (ValueError, TypeError, ZeroDivisionError, FloatingPointError) as e:
-            t.fail(
-                key,
-                f"{e} (write a number, an expression of s and L, or {{ s = [...], values = [...] }})",
-            )
-        if positive and not np.all(values > 0):
-            t.fail(
-                key,
-                f"must be positive along the whole beam; its smallest value is {values.min():g}",
-            )
-        return f
-    return t.get(key, float, default, positive=positive)
-
-
-def _history(t, key="history"):
-    """A function of time: a number, an expression of ``t`` or a table
-    ``{ t = [...], values = [...] }`` (piecewise linear, constant beyond its ends); None if
-    the key is absent."""
-    if not t.has(key):
-        return None
-    raw = t.data.get(key)
-    t.used.add(key)
-    try:
-        if isinstance(raw, bool):
-            raise TypeError(f"{raw!r} is not a number")
-        if isinstance(raw, (int, float)):
-            value = float(raw)
-            f = partial(np.full_like, fill_value=value, dtype=float)
-            f.text = str(value)
-        elif isinstance(raw, str):
-            f = compile_expression(raw, "t")
-        elif isinstance(raw, dict):
-            sub = Table(raw, t.path + "." + key, t.file)
-            f = table_function(sub.get("t", list), sub.get("values", list))
-            sub.done()
-        else:
-            raise TypeError(f"{raw!r} is not a number, expression or table")
-        values = f(np.linspace(0.0, 1.0, 11))
-        if not np.all(np.isfinite(values)):
-            raise ValueError("it is not finite on [0, 1]")
-    except (ValueError, TypeError, ZeroDivisionError, FloatingPointError) as e:
-        t.fail(key, f"{e} (write a number, an expression of t, or {{ t = [...], values = [...] }})")
-    return f
-
-
-def _arm(t, kind, moment_key):
-    """The arm of a quasitangential moment (required for that kind, refused for the others)."""
-    if kind != "quasitangential":
-        if t.has("arm"):
-            t.fail("arm", f"only a kind = 'quasitangential' moment has an arm, not {kind!r}")
-        return None
-    arm = np.asarray(t.get("arm", "vec3"))
-    moment = np.asarray(t.get(moment_key, "vec3", (0.0,) * 3))
-    norm = np.linalg.norm(arm)
-    if norm == 0 or abs(arm @ moment) > 1e-9 * norm * np.linalg.norm(moment):
-        t.fail("arm", f"must be a non-zero vector normal to '{moment_key}', got {list(arm)}")
-    return tuple(arm)
-
-
-def _point_mass(t):
-    """A ``[[masses]]`` table: ``at``, ``mass`` and ``inertia`` ([Jxx, Jyy, Jzz] or 3x3)."""
-    at = t.get("at", str)
-    mass = t.get("mass", float, 0.0)
-    if mass < 0:
-        t.fail("mass", f"must not be negative, got {mass}")
-    J = np.zeros((3, 3))
-    if t.has("inertia"):
-        raw = t.get("inertia", list)
-
-        def numbers(row):
-            return (
-                isinstance(row, list)
-                and len(row) == 3
-                and all(isinstance(x, Real) and not isinstance(x, bool) for x in row)
-            )
-
-        if numbers(raw):
-            J = np.diag(np.array(raw, float))
-        elif len(raw) == 3 and all(numbers(row) for row in raw):
-            J = np.array(raw, float)
-        else:
-            t.fail("inertia", f"expected [Jxx, Jyy, Jzz] or a 3x3 list of numbers, got {raw!r}")
-        scale = np.abs(J).max()
-        if np.abs(J - J.T).max() > 1e-12 * scale:
-            t.fail("inertia", "must be symmetric")
-        smallest = np.linalg.eigvalsh(J).min()
-        if smallest < -1e-12 * scale:
-            t.fail(
-                "inertia",
-                f"must be positive semi-definite; its smallest eigenvalue is {smallest:g}",
-            )
-    if mass == 0 and not J.any():
-        t.fail("mass", "give a positive 'mass' and/or a non-zero 'inertia'")
-    return PointMass(at, mass, tuple(tuple(float(x) for x in row) for row in J))
-
-
-def _section(t, mat, length):
-    """A Section, or a SectionAlong if a value varies along the beam."""
-    kind = t.get("type", str, choices=SECTION_TYPES)
-    k = t.get("shear_factor", float, None, positive=True)
-    along = partial(_along, t, length=length)
-    if kind == "general":
-        params = {key: along(key) for key in ("EA", "GA_y", "GA_z", "GJ", "EI_y", "EI_z")}
-        params["rho_A"] = along("rho_A", default=0.0, positive=False)
-        rho_I = t.get("rho_I", "vec3", (0.0, 0.0, 0.0))
-
-        def make(rho_I=rho_I, **values):
-            return sections.Section(**values, rho_I=rho_I)
-
-    else:
-        if mat is None:
-            t.fail("type", "a geometric section needs the [material] table (E, nu, rho)")
-        E, G, rho, nu = mat
-        if kind == "rectangle":
-            torsion = t.get("torsion", (str, float, int), "saint-venant")
-            if (
-                isinstance(torsion, bool)
-                or (not isinstance(torsion, str) and torsion <= 0)
-                or (isinstance(torsion, str) and torsion not in ("saint-venant", "thin-strip"))
-            ):
-                t.fail(
-                    "torsion",
-                    f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J",
-                )
-            params = {"h": along("h"), "w": along("w")}
-            make = partial(sections.rectangle, E, G, rho, torsion=torsion, shear_factor=k, nu=nu)
-        elif kind == "circle":
-            params = {"d": along("d")}
-            make = partial(sections.tube, E, G, rho, d_inner=0.0, shear_factor=k, nu=nu)
-        else:
-            params = {"d": along("d"), "d_inner": along("d_inner", positive=False)}
-            make = partial(sections.tube, E, G, rho, shear_factor=k, nu=nu)
-            s = np.linspace(0.0, length, 201)
-            d, di = (p(s) if callable(p) else np.full_like(s, p) for p in params.values())
-            if not np.all((0 <= di) & (di < d)):
-                t.fail("d_inner", "must satisfy 0 <= d_inner < d along the whole beam")
-    t.done()
-    if any(callable(v) for v in params.values()):
-        return sections.SectionAlong(make, params)
-    return make(**params)
-
-
-def _material(t):
-    if t is None:
-        return None
-    E = t.get("E", float, positive=True)
-    nu = t.get("nu", float, 0.3)
-    if not -1 < nu < 0.5:
-        t.fail("nu", f"must lie in (-1, 0.5), got {nu}")
-    G = t.get("G", float, E / (2 * (1 + nu)), positive=True)
-    rho = t.get("rho", float, 0.0)
-    t.done()
-    return E, G, rho, nu
-
-
-def _fix(t):
-    fix = t.get("fix", (str, list))
-    if isinstance(fix, str):
-        if fix not in FIX_WORDS:
-            t.fail(
-                "fix",
-                f"{fix!r} is not allowed; allowed: {list(FIX_WORDS)} or a list of {list(DOF_NAMES)}",
-            )
-        return tuple(FIX_WORDS[fix])
-    bad = [d for d in fix if d not in DOF_NAMES]
-    if bad or not fix:
-        t.fail("fix", f"{bad or fix} not allowed; allowed: a list of {list(DOF_NAMES)}")
-    return tuple(fix)
-
-
 def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Scene:
     """Scene from already-parsed TOML data (``file`` is used in error messages)."""
     top = Table(data, "", file)
-    mat = _material(top.table("material", None))
-    beams = _beams(top, mat, base, file)
-    supports = _supports(top)
-    point_loads, distributed, gravity = _loads(top)
-    springs = _springs(top)
-    masses = _masses(top)
-
-    mt = top.table("model", {})
-    plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
-    condense = mt.get("condense", str, "auto", choices=("auto", "none"))
-    kin = Kinematics(
-        finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
-        shear=mt.get("shear", bool, True),
-        stretch=mt.get("stretch", bool, True),
-        plane=plane if plane in PLANES else None,
-    )
-    mt.done()
+    limits = read_limits(top)
+    mat = read_material(top.table("material", None))
+    beams = _beams(top, mat, base, limits)
+    supports = read_supports(top)
+    point_loads, distributed, gravity = read_loads(top)
+    springs = read_springs(top)
+    masses = read_masses(top)
+    plane, condense, kin = _model_table(top.table("model", {}))
     at = top.table("analysis", {})
-    analysis, settings = _analysis(at, Model(tuple(beams), tuple(supports)))
+    analysis, settings = _analysis(at, Model(tuple(beams), tuple(supports)), limits)
     if analysis.linear:
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
 
     probes = _probes(top)
-    output = _output(top.table("output", {}))
+    output = _output(top.table("output", {}), limits)
     solver = top.get("solver", dict, {})
     for key, message in option_problems(solver):  # an allow-list: no viewers, logs, files
         top.fail(f"solver.{key}", message)
@@ -350,7 +92,8 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         kin,
         point_masses=tuple(masses),
     )
-    _check_points(model, probes, file)
+    _check_points(model, probes, file, data.get("loads", []))
+    _check_histories(model, settings, file, data.get("loads", []))
     if not model.supports and not getattr(settings, "free_body", lambda m: False)(model):
         raise SceneError(
             f"{file}: supports: none given; the structure is free (rigid-body motion), which "
@@ -363,7 +106,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         condense = condensed_fit(model, analysis.name) is None
     else:
         condense = False
-    accuracy = _accuracy(accuracy_table, probes, analysis.name)
+    accuracy = _accuracy(accuracy_table, probes, analysis.name, limits)
     _check_model(model, file)
     return Scene(
         file,
@@ -379,15 +122,56 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     )
 
 
-def _beams(top, mat, base, file):
+def _model_table(mt):
+    """``[model]``: (plane choice, condense choice, :class:`Kinematics`)."""
+    plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
+    condense = mt.get("condense", str, "auto", choices=("auto", "none"))
+    kin = Kinematics(
+        finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
+        shear=mt.get("shear", bool, True),
+        stretch=mt.get("stretch", bool, True),
+        plane=plane if plane in PLANES else None,
+    )
+    mt.done()
+    return plane, condense, kin
+
+
+def _check_size(top, beams, limits):
+    """The model's unknowns within ``[limits] max_unknowns``, its mesh not over itself."""
+    n = unknowns(beams)
+    if n > limits.max_unknowns:
+        cells = [max(b.elements, len(b.curve.kinks) + 1) for b in beams]
+        i = max(range(len(beams)), key=cells.__getitem__)
+        kinks = cells[i] > beams[i].elements
+        top.fail(
+            f"beams[{i}].{'curve.points' if kinks else 'elements'}",
+            f"= {f'{cells[i] - 1} kinks' if kinks else beams[i].elements}: the model would "
+            f"have about {n:.3g} unknowns (7 per node; elements, at least one per kink, times "
+            f"the degree); allowed: at most {limits.max_unknowns} ([limits] max_unknowns "
+            "raises it)",
+        )
+    problem = overlap(beams)
+    if problem:
+        top.fail(f"beams[{problem[0]}].curve", problem[1])
+
+
+def _beams(top, mat, base, limits):
     """``[[beams]]``: the beams, their names unique."""
-    beams = []
-    for t in top.tables("beams"):
+    beams, tables = [], top.tables("beams")
+    if len(tables) > limits.max_beams:
+        top.fail(
+            "beams",
+            f"{len(tables)} [[beams]] tables; allowed: at most {limits.max_beams} "
+            "([limits] max_beams raises it)",
+        )
+    names = set()
+    for t in tables:
         name = t.get("name", str)
-        if ":" in name or name in [b.name for b in beams]:
+        if ":" in name or name in names:
             t.fail("name", f"{name!r} must be unique and contain no ':'")
-        curve = _curve(t.table("curve"), base)
-        section = _section(t.table("section"), mat, curve.length)
+        names.add(name)
+        curve = read_curve(t.table("curve"), base, limits)
+        section = read_section(t.table("section"), mat, curve.length)
         beams.append(
             Beam(
                 name,
@@ -402,101 +186,10 @@ def _beams(top, mat, base, file):
         t.done()
     if not beams:
         top.fail("beams", "a scene needs at least one [[beams]] table")
+    _check_size(top, beams, limits)
     for i, b in enumerate(beams):
-        _check_orientation(b, f"{file}: beams[{i}].orientation")
+        _check_orientation(b, top.where(f"beams[{i}].orientation"))
     return beams
-
-
-def _supports(top):
-    """``[[supports]]``: fixed dofs, prescribed motion."""
-    supports = []
-    for t in top.tables("supports"):
-        sup = Support(
-            t.get("at", str),
-            _fix(t),
-            t.get("displacement", "vec3", (0.0,) * 3),
-            t.get("rotation", "vec3", (0.0,) * 3),
-            t.get("axes", str, "global", choices=AXES),
-            _history(t),
-        )
-        free = [
-            DOF_NAMES[i] for i in range(3) if sup.displacement[i] and DOF_NAMES[i] not in sup.fix
-        ]
-        if free:
-            t.fail(
-                "displacement", f"prescribed on {free}, which 'fix' leaves free; add them to fix"
-            )
-        if any(sup.rotation) and not {"rx", "ry", "rz"} <= set(sup.fix):
-            t.fail("rotation", "a prescribed rotation needs rx, ry and rz in fix")
-        supports.append(sup)
-        t.done()
-    return supports
-
-
-def _loads(top):
-    """``[[loads]]``: point loads, distributed loads and gravity."""
-    point_loads, distributed, gravity = [], [], (0.0, 0.0, 0.0)
-    for t in top.tables("loads"):
-        if t.has("gravity"):
-            gravity = t.get("gravity", "vec3")
-            t.done()
-            continue
-        kind = t.get("kind", str, "dead", choices=LOAD_KINDS)
-        if t.has("at"):
-            point_loads.append(
-                PointLoad(
-                    t.get("at", str),
-                    t.get("force", "vec3", (0.0,) * 3),
-                    t.get("moment", "vec3", (0.0,) * 3),
-                    kind,
-                    _history(t),
-                    arm=_arm(t, kind, "moment"),
-                )
-            )
-        else:
-            axes = t.get("axes", str, "global", choices=("global", "section"))
-            if axes == "section" and kind == "quasitangential":
-                t.fail("axes", "a quasitangential moment's arm is global: give axes = 'global'")
-            distributed.append(
-                DistributedLoad(
-                    t.get("beam", str, None),
-                    t.get("force_per_length", "vec3", (0.0,) * 3),
-                    t.get("moment_per_length", "vec3", (0.0,) * 3),
-                    kind,
-                    _history(t),
-                    arm=_arm(t, kind, "moment_per_length"),
-                    axes=axes,
-                )
-            )
-        t.done(
-            " (a point load has 'at'; a distributed one 'beam' or neither for all beams; or 'gravity')"
-        )
-    return point_loads, distributed, gravity
-
-
-def _springs(top):
-    """``[[springs]]``: springs to ground."""
-    springs = []
-    for t in top.tables("springs"):
-        sp = Spring(
-            t.get("at", str),
-            t.get("stiffness", "vec3", (0.0,) * 3),
-            t.get("rotational", "vec3", (0.0,) * 3),
-        )
-        if min(*sp.stiffness, *sp.rotational) < 0 or not any((*sp.stiffness, *sp.rotational)):
-            t.fail("stiffness", "give non-negative 'stiffness' and/or 'rotational', not all zero")
-        springs.append(sp)
-        t.done()
-    return springs
-
-
-def _masses(top):
-    """``[[masses]]``: rigid bodies attached at points."""
-    masses = []
-    for t in top.tables("masses"):
-        masses.append(_point_mass(t))
-        t.done()
-    return masses
 
 
 def _probes(top):
@@ -511,16 +204,16 @@ def _probes(top):
     return probes
 
 
-def _output(t):
+def _output(t, limits):
     """``[output]``: where the results go and which frames, by the fields of
     :class:`~beamfx.io.output.OutputSettings`."""
     from ..io.output import OutputSettings
     from .schema import read_settings
 
-    return read_settings(OutputSettings, t)
+    return read_settings(OutputSettings, t, max_count=limits.max_count)
 
 
-def _analysis(t, model):
+def _analysis(t, model, limits):
     """The :class:`~beamfx.analyses.registry.Analysis` of ``[analysis] type`` and its settings,
     read from the rest of the table by the settings class's fields."""
     from ..analyses.registry import analyses
@@ -528,9 +221,16 @@ def _analysis(t, model):
 
     entry = analyses()[t.get("type", str, "static", choices=tuple(analyses()))]
     defaults = getattr(entry.settings, "defaults", lambda model: {})(model)
-    settings = read_settings(entry.settings, t, defaults)
+    settings = read_settings(entry.settings, t, defaults, max_count=limits.max_count)
     for key, message in getattr(settings, "problems_in", lambda model: ())(model):
         t.fail(key, message)
+    t_end, dt = getattr(settings, "t_end", None), getattr(settings, "dt", None)
+    if t_end is not None and dt is not None and t_end / dt > limits.max_count:
+        t.fail(
+            "dt",
+            f"= {dt:g}: t_end / dt = {t_end / dt:.3g} time steps; allowed: at most "
+            f"{limits.max_count} ([limits] max_count raises it)",
+        )
     return entry, settings
 
 
@@ -554,7 +254,7 @@ def _trim(model, plane, analysis, settings):
     return model, trim
 
 
-def _accuracy(t, probes, analysis):
+def _accuracy(t, probes, analysis, limits):
     """``[accuracy]``: element count and degree chosen to meet a tolerance on a probe quantity
     (:mod:`beamfx.analyses.adaptive`)."""
     from ..analyses.adaptive import DEGREES, QUANTITIES
@@ -582,6 +282,13 @@ def _accuracy(t, probes, analysis):
     }
     if out["max_degree"] < out["start_degree"]:
         t.fail("max_degree", f"must be at least start_degree ({out['start_degree']})")
+    for key in ("max_unknowns", "start_elements"):
+        if out[key] > limits.max_unknowns:
+            t.fail(
+                key,
+                f"= {out[key]}: allowed: at most {limits.max_unknowns} "
+                "([limits] max_unknowns raises it)",
+            )
     t.done()
     return out
 
@@ -603,30 +310,60 @@ def _check_model(model, file):
             )
 
 
-def _check_points(model, probes, file):
+def _load_indices(loads):
+    """Indices in ``[[loads]]`` of the point loads and of the distributed loads, in order."""
+    at_load = [i for i, t in enumerate(loads) if "gravity" not in t and "at" in t]
+    on_beam = [i for i, t in enumerate(loads) if "gravity" not in t and "at" not in t]
+    return at_load, on_beam
+
+
+def _check_histories(model, settings, file, loads):
+    """Every load and support history finite over the whole run (``[0, t_end]`` of a
+    transient; the reader checked ``[0, 1]``)."""
+    t_end = getattr(settings, "t_end", None)
+    if t_end is None:
+        return
+    at_load, on_beam = _load_indices(loads)
+    timed = [(f"loads[{i}]", p) for i, p in zip(at_load, model.point_loads)]
+    timed += [(f"loads[{i}]", d) for i, d in zip(on_beam, model.distributed_loads)]
+    timed += [(f"supports[{i}]", s) for i, s in enumerate(model.supports)]
+    t = np.linspace(0.0, t_end, 1001)
+    for where, item in timed:
+        if item.history is not None:
+            with np.errstate(all="ignore"):
+                values = np.asarray(item.history(t), float)
+            if not np.all(np.isfinite(values)):
+                bad = float(t[~np.isfinite(values)][0])
+                raise SceneError(
+                    f"{file}: {where}.history: not finite at t = {bad:g} (within [0, t_end]); "
+                    "allowed: a function finite over the whole run"
+                )
+
+
+def _check_points(model, probes, file, loads):
+    """Every named point on a beam, every load's beam a beam (``loads``: the scene's
+    ``[[loads]]`` tables, for the index of each load in the messages)."""
     from ..spec import resolve_point
 
+    at_load, on_beam = _load_indices(loads)
     named = [(f"supports[{i}].at", s.at) for i, s in enumerate(model.supports)]
-    named += [(f"loads.at ({p.at})", p.at) for p in model.point_loads]
+    named += [(f"loads[{i}].at", p.at) for i, p in zip(at_load, model.point_loads)]
     named += [(f"springs[{i}].at", s.at) for i, s in enumerate(model.springs)]
     named += [(f"masses[{i}].at", m.at) for i, m in enumerate(model.point_masses)]
-    named += [(f"probes.{k}.at", v) for k, v in probes.items()]
+    named += [(f"probes[{i}].at", v) for i, v in enumerate(probes.values())]
     for where, at in named:
         try:
             resolve_point(model, at)
         except ValueError as e:
             raise SceneError(f"{file}: {where}: {e}") from None
-    for d in model.distributed_loads:
-        if d.beam is not None and d.beam not in [b.name for b in model.beams]:
-            raise SceneError(
-                f"{file}: loads.beam: {d.beam!r} is no beam; beams are {[b.name for b in model.beams]}"
-            )
+    beams = [b.name for b in model.beams]
+    for i, d in zip(on_beam, model.distributed_loads):
+        if d.beam is not None and d.beam not in beams:
+            raise SceneError(f"{file}: loads[{i}].beam: {d.beam!r} is no beam; beams are {beams}")
 
 
 def _check_orientation(beam, where):
     """The reference vector must not be parallel to the centre line anywhere."""
-    import numpy as np
-
     if beam.orientation is None:
         return
     s = np.linspace(0, beam.curve.length, 201)
@@ -642,16 +379,6 @@ def _check_orientation(beam, where):
             f"{where}: {list(o)} is parallel to the centre line of beam {beam.name!r} "
             "somewhere; give a vector normal to it (the section's local z)"
         )
-
-
-def read_toml(path: str | os.PathLike) -> dict:
-    """The TOML data of the file at ``path``; a missing or malformed file is a SceneError."""
-    try:
-        return tomllib.loads(Path(path).read_text())
-    except FileNotFoundError:
-        raise SceneError(f"{path}: no such scene file") from None
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{path}: not valid TOML: {e}") from None
 
 
 def load_scene(path: str | os.PathLike) -> Scene:

@@ -6,11 +6,10 @@ numbers are refused; a settings class may add checks across fields with a method
 """
 
 import dataclasses
-import math
 import numbers
 
 from ..settings import Vec3, describe, is_settings, specs
-from .table import SceneError
+from .table import MAX_INT, SceneError, is_number, joined
 
 
 def _number(value):
@@ -34,37 +33,45 @@ def _convert(spec, value, fail):
     if kind is int:
         if not isinstance(value, int) or isinstance(value, bool):
             fail(bad)
+        if abs(value) > MAX_INT:
+            fail(f"= {value}: must be at most {MAX_INT:.0e}")
         return value
     if kind is float:
-        if not _number(value) or not math.isfinite(value):
-            fail(bad)
+        if not is_number(value):
+            fail(f"= {value!r}: must be a finite {describe(spec)}" if _number(value) else bad)
         return float(value)
     if kind == tuple[str, ...]:
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             fail(bad)
         return tuple(value)
-    ok = isinstance(value, list) and all(_number(v) and math.isfinite(v) for v in value)
+    ok = isinstance(value, list) and all(map(is_number, value))
     if not ok or (kind == Vec3 and len(value) != 3) or not value:
         fail(bad)
     return tuple(float(v) for v in value)
 
 
-def _check_range(spec, value, fail):
+def _check_range(spec, value, fail, max_count=None):
     values = value if isinstance(value, tuple) else (value,)
+    if max_count is not None and len(values) > max_count:  # e.g. a list of spin speeds
+        fail(f"a list of {len(values)}; allowed: at most {max_count} ([limits] max_count)")
     for v in values:
         if spec.choices is not None and v not in spec.choices:
             fail(f"{v!r} is not allowed; allowed: {list(spec.choices)}")
         if isinstance(v, (str, bool)):
             continue
         if (
-            (spec.positive and v <= 0)
-            or (spec.low is not None and v < spec.low)
-            or (spec.high is not None and v > spec.high)
+            (spec.positive and not v > 0)
+            or (spec.low is not None and not v >= spec.low)
+            or (spec.high is not None and not v <= spec.high)
         ):
-            fail(f"must be {describe(spec)}, got {v!r}")
+            fail(f"= {v!r}: must be {describe(spec)}")
+        if spec.kind is int and max_count is not None and v > max_count:
+            fail(f"= {v}: allowed: at most {max_count} ([limits] max_count raises it)")
 
 
-def read_settings(cls: type, table, defaults: dict | None = None, done: bool = True):
+def read_settings(
+    cls: type, table, defaults: dict | None = None, done: bool = True, max_count=None
+):
     """An instance of the settings class ``cls`` from ``table`` (:class:`~.table.Table`).
 
     Args:
@@ -74,6 +81,8 @@ def read_settings(cls: type, table, defaults: dict | None = None, done: bool = T
             default that depends on another key).
         done: reject keys of ``table`` that are not fields (set False when the caller reads
             more keys from the same table).
+        max_count: the largest value of an integer field (a count of steps, modes, frames:
+            ``[limits] max_count``); None: no bound beyond the field's own.
 
     Raises:
         SceneError: naming the file, the key path and the allowed values.
@@ -84,12 +93,12 @@ def read_settings(cls: type, table, defaults: dict | None = None, done: bool = T
         where = table.where(spec.name) if table is not None else spec.name
 
         def fail(message, where=where):
-            raise SceneError(f"{where}: {message}")
+            raise SceneError(joined(where, message))
 
         present = table is not None and table.has(spec.name)
         if is_settings(spec.kind):  # a sub-table, all defaults when left out
             sub = table.table(spec.name, {}) if table is not None else None
-            values[spec.name] = read_settings(spec.kind, sub)
+            values[spec.name] = read_settings(spec.kind, sub, max_count=max_count)
             continue
         if table is not None:
             table.used.add(spec.name)
@@ -100,7 +109,7 @@ def read_settings(cls: type, table, defaults: dict | None = None, done: bool = T
                 fail(f"missing; expected {describe(spec)}")
             continue
         value = _convert(spec, table.data[spec.name], fail)
-        _check_range(spec, value, fail)
+        _check_range(spec, value, fail, max_count)
         values[spec.name] = value
     obj = cls(**values)
     for key, message in getattr(obj, "problems", lambda: ())():

@@ -73,7 +73,7 @@ def test_run_reports_the_estimate_beside_the_answer(tmp_path):
     [
         ({"quantity": "nope.position"}, "probe one of ['tip']"),
         ({"quantity": "tip.speed"}, "quantity one of ['position'"),
-        ({"tolerance": -1.0}, "accuracy.tolerance: must be positive"),
+        ({"tolerance": -1.0}, "accuracy.tolerance = -1.0: must be a finite number > 0"),
         ({"max_degree": 1}, "accuracy.max_degree: must be at least start_degree (2)"),
         ({"colour": 1}, "accuracy.colour: unknown key"),
     ],

@@ -32,13 +32,13 @@ def scene_with(edit):
             lambda d: d["beams"][0]["curve"].update(shape="circle"),
             ["beams[0].curve.shape", "allowed", "arc"],
         ),
-        (lambda d: d["beams"][0]["curve"].update(angle_deg=0), ["angle_deg", "must be positive"]),
-        (lambda d: d["material"].update(E=-1.0), ["material.E", "must be positive"]),
+        (lambda d: d["beams"][0]["curve"].update(angle_deg=0), ["angle_deg = 0", "> 0"]),
+        (lambda d: d["material"].update(E=-1.0), ["material.E = -1.0", "finite number > 0"]),
         (
             lambda d: d["beams"][0]["section"].update(
                 type="general", EA=1.0, GA_y=1.0, GA_z=1.0, GJ=0.0, EI_y=1.0, EI_z=1.0
             ),
-            ["section.GJ", "must be positive"],
+            ["section.GJ = 0.0", "finite number > 0"],
         ),
         (lambda d: d["loads"][0].update(at="bnd:end"), ["'bnd:end'", "names no beam", "bend"]),
         (lambda d: d["loads"][0].update(at="bend:1.5"), ["bend:1.5", "[0, 1]"]),
@@ -51,7 +51,7 @@ def scene_with(edit):
             lambda d: d["beams"][0].update(
                 curve={"shape": "line", "start": [0, 0, 0], "end": [0, 0, 0]}
             ),
-            ["zero-length"],
+            ["beams[0].curve.end", "zero length"],
         ),
     ],
 )

@@ -31,6 +31,12 @@ def test_docs_name_every_analysis_key_and_no_other():
     assert _section_keys("analysis") == fields
 
 
+def test_docs_name_every_limits_key_and_no_other():
+    from beamfx.scene.limits import Limits
+
+    assert _section_keys("limits") == {s.name for s in specs(Limits)}
+
+
 def test_docs_name_every_output_key_and_no_other():
     from beamfx.io.output import OutputSettings
 
