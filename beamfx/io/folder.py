@@ -209,7 +209,9 @@ def claim(folder, comm, scene, restart=False, log=None):
         signal = interruption(e)
         if signal is not None:
             stopped = {"scene": str(scene), "converged": False, "status": "stopped"}
-            write_json_atomic(Path(folder) / "results.json", {**stopped, "reason": str(signal)}, comm)
+            write_json_atomic(
+                Path(folder) / "results.json", {**stopped, "reason": str(signal)}, comm
+            )
         raise
     finally:
         if lock:
