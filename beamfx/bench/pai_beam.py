@@ -159,8 +159,9 @@ def _march(model, settings, saved=None, coordinate=None):
             q.append(coordinate(model.w.x.array))
 
     if saved is not None:  # a start from a given state: solve_transient reports no step 0
-        model.w.x.array[:] = saved["q_n"]
-        record(saved["t"])
+        header, arrays = saved
+        model.w.x.array[:] = arrays["q_n"]
+        record(header["t"])
     t0 = time.perf_counter()
     result = solve_transient(model, settings, on_step=lambda r: record(r.time), saved=saved)
     seconds = time.perf_counter() - t0
@@ -279,20 +280,23 @@ def run_free_decay(tip_velocity, t_end, dt=0.0025, elements=5, degree=3, damping
     model = BeamModel(pai_model(elements, degree), extra_points=["b:end"])
     modes = linear_modes(model)
     zero = np.zeros_like(modes.static)
-    saved = {
+    arrays = {
         "q_n": modes.static,
         "v_n": tip_velocity * modes.second,
         "a_n": zero,
         "qdd_n": zero.copy(),
+    }
+    header = {  # a checkpoint's (header, arrays): solve_transient goes on from this state
         "t": 0.0,
-        "h": dt,
         "step": 0,
+        "controller": {"size": dt},
         "balance": {
             "values": dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0),
             "initial": None,
-            "previous": None,
+            "power": None,
         },
     }
+    saved = (header, arrays)
     settings = transient_settings(t_end, dt, damping)
     return _march(model, settings, saved, modes.coordinate), modes
 
