@@ -40,13 +40,18 @@ class RunContext:
     restart: bool = False
     rebuild: Callable | None = None
     latest: dict | None = None  # probe values of the last accepted state, tracked
+    _points: list | None = field(default=None, init=False, repr=False)  # the probes' points
 
-    def probe_values(self, model, track=True):
+    def probe_values(self, model, track=True, full=True):
         """Probe values of the model's current state (collective): ``{point: values}``, the
-        rotations unwrapped along the path of earlier calls when ``track``."""
+        rotations unwrapped along the path of earlier calls when ``track``; with ``full=False``
+        only position, displacement and rotation (a history's columns, at every step: call
+        it once more with ``full=True`` at the end, the final probes read :attr:`latest`)."""
         from ..io import evaluate_points, track_rotations
 
-        values = evaluate_points(model, list(dict.fromkeys(self.probes.values())))
+        if self._points is None:
+            self._points = list(dict.fromkeys(self.probes.values()))
+        values = evaluate_points(model, self._points, full=full)
         self.latest = track_rotations(self.latest if track else None, values)
         return self.latest
 

@@ -224,8 +224,11 @@ class BeamModel(Discretised):
     def set_load_factor(self, lam):
         """Scale loads and prescribed values (a prescribed rotation turns by lam times its angle)."""
         self.load_factor.value = lam
+        factors = {None: 1.0}  # each history evaluated once (a support has one per dof)
         for c, value, history in self._bc_values:
-            c.value = value(lam * (1.0 if history is None else float(history(self.time))))
+            if history not in factors:
+                factors[history] = float(history(self.time))
+            c.value = value(lam * factors[history])
 
     def set_time(self, t):
         """Time of a transient: loads and supports with a history take their values at ``t``

@@ -281,7 +281,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     energy = {}
 
     def on_step(r):
-        values = ctx.probe_values(model)
+        values = ctx.probe_values(model, full=False)
         energy.update(r.energy)
         history.add(r, values)
         if ctx.frames.want(r.step, r.time):
@@ -306,6 +306,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         history.close()
     if result.steps:
         ctx.last_frame(result.steps[-1].step, result.steps[-1].time)
+    ctx.probe_values(model)  # all the values at the final state, tracked as the history
     stopped = result.stopped_by != "t_end"
     return Result(
         analysis=ctx.analysis,

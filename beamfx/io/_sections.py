@@ -78,7 +78,7 @@ def lagrange_matrix(nodes, x):
     return A
 
 
-def evaluate(model, points, cells, recover=True):
+def evaluate(model, points, cells, recover=True, full=True):
     r"""Section quantities at reference ``points`` (shape (n, 1)) of local ``cells``.
 
     With ``recover`` (the default) N and M are not taken pointwise but recovered: sampled at
@@ -91,6 +91,10 @@ def evaluate(model, points, cells, recover=True):
 
     Collective the first time for a given model and points (JIT compilation); afterwards
     purely local. Ghost values of ``model.w`` must be up to date (the solvers scatter them).
+
+    With ``full=False`` only ``X``, ``u`` and ``rot`` are returned (the same compiled
+    expression, the same values), without the recovery and the section axes: what a probe
+    history needs at every step.
 
     Returns:
         dict name -> array of shape (len(cells), len(points), size), names as in the module
@@ -116,6 +120,8 @@ def evaluate(model, points, cells, recover=True):
     else:
         values = np.zeros((0, len(sample), size))
     n = len(points)
+    if not full:
+        return {name: values[:, :n, layout[name]] for name in ("X", "u", "rot")}
     out = {name: values[:, :n, s] for name, s in layout.items()}
     if recover:
         A = _recovery_matrix(model.degree, key[:n])

@@ -76,7 +76,19 @@ def _point_values(finite, v):
     return out
 
 
-def evaluate_points(model, names=None, recover=True):
+def _kinematic_values(finite, v):
+    """``position``, ``displacement`` and the rotation (``quaternion`` of finite kinematics,
+    else ``rotation_vector``) of one point: :func:`_point_values` without the rest."""
+    X, u, rot = v["X"], v["u"], v["rot"]
+    out = {"position": (X + u).tolist(), "displacement": u.tolist()}
+    if finite:
+        out["quaternion"] = (rot / np.linalg.norm(rot)).tolist()
+    else:
+        out["rotation_vector"] = rot.tolist()
+    return out
+
+
+def evaluate_points(model, names=None, recover=True, full=True):
     """Evaluate the solution at named points. Collective.
 
     Args:
@@ -84,6 +96,9 @@ def evaluate_points(model, names=None, recover=True):
         names: names of ``model.mesh.points`` (all of them if None).
         recover: N and M extrapolated from the cell's Gauss points (default) rather than
             taken pointwise at the vertex, see :func:`beamfx.io._sections.evaluate`.
+        full: all the values below; if False only ``position``, ``displacement`` and the
+            ``quaternion`` (finite kinematics) or ``rotation_vector`` (linear), the same
+            numbers, for a history that records them at every step.
 
     Returns:
         ``{name: values}`` on every rank, where ``values`` holds plain lists and floats:
@@ -106,11 +121,12 @@ def evaluate_points(model, names=None, recover=True):
         raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
     model.sync()  # derived fields (the condensed model integrates its displacement)
     found, cells = _plan(model, names)
-    values = evaluate(model, cell_nodes(model.degree), cells, recover)
+    values = evaluate(model, cell_nodes(model.degree), cells, recover, full)
+    point_values = _point_values if full else _kinematic_values
     local = {}
     for i, (n, end) in enumerate(found):
         node = end * model.degree  # ξ = 0 or 1
-        local[n] = _point_values(model.kin.finite, {k: a[i, node] for k, a in values.items()})
+        local[n] = point_values(model.kin.finite, {k: a[i, node] for k, a in values.items()})
 
     result = {}
     for part in comm.allgather(local) if comm.size > 1 else [local]:
