@@ -169,7 +169,9 @@ class History:
         self.files = None
         if not self.root:
             return
-        header = ",".join(_columns(probes))
+        columns = _columns(probes)
+        header = ",".join(columns)
+        self.row_format = ",".join(["{:.12g}"] * len(columns)) + "\n"
         if t_restart is None:
             self.csv.write_text(header + "\n")
             self.jsonl.write_text("")
@@ -200,7 +202,7 @@ class History:
             entry["probes"][name] = {k: v[k] for k in keys}
         row += [r.energy[k] for k in ENERGY_KEYS]
         entry["energy"] = r.energy
-        self.files[0].write(",".join(f"{x:.12g}" for x in row) + "\n")
+        self.files[0].write(self.row_format.format(*row))
         self.files[1].write(json.dumps(entry) + "\n")
 
     def flush(self):
@@ -256,6 +258,8 @@ def _progress(comm, t_end):
     bar = Progress(label="transient", every=5.0, comm=comm)
 
     def progress(r):
+        if not bar.due():  # the line is made only when it is shown
+            return
         residual = r.residuals[-1] if r.residuals else 0.0
         bar.update(
             r.step,

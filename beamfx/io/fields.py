@@ -5,9 +5,13 @@ along the cell; nodes are duplicated between cells, so the representation is dis
 and keeps the section force and moment of each cell (they jump at point loads and joints).
 """
 
+import weakref
+
 import numpy as np
 
 from ._sections import cell_nodes, evaluate
+
+_owned = weakref.WeakKeyDictionary()  # model -> (cells, input indices, beams)
 
 POINT_ARRAYS = ("X", "u", "e1", "e2", "e3", "N", "M")
 
@@ -29,20 +33,29 @@ def local_fields(model, recover=True):
         input index and ``beam`` its beam index (cells,).
     """
     model.sync()  # derived fields (the condensed model integrates its displacement)
-    m = model.mesh.mesh
-    k = model.degree
-    n_owned = m.topology.index_map(m.topology.dim).size_local
-    original = np.asarray(m.topology.original_cell_index[:n_owned], dtype=np.int64)
-    order = np.argsort(original, kind="stable")
-    cells = np.arange(n_owned, dtype=np.int32)[order]
-    values = evaluate(model, cell_nodes(k), cells, recover)
+    cells, cell, beam = _owned_cells(model)
+    values = evaluate(model, cell_nodes(model.degree), cells, recover)
     axes = values["axes"]
     out = {"X": values["X"], "u": values["u"], "N": values["N"], "M": values["M"]}
     out.update(e1=axes[..., 0], e2=axes[..., 1], e3=axes[..., 2])
     out = {name: np.ascontiguousarray(out[name]).reshape(-1, 3) for name in POINT_ARRAYS}
-    out["cell"] = original[order]
-    out["beam"] = np.asarray(model.mesh.cell_beam[:n_owned], dtype=np.int64)[order]
+    out["cell"], out["beam"] = cell.copy(), beam.copy()
     return out
+
+
+def _owned_cells(model):
+    """(local cells, their input indices, their beams) of the cells this rank owns, in input
+    order; cached per model (a frame writer asks at every frame; its mesh does not change)."""
+    mesh = model.mesh
+    if model not in _owned:
+        m = mesh.mesh
+        n_owned = m.topology.index_map(m.topology.dim).size_local
+        original = np.asarray(m.topology.original_cell_index[:n_owned], dtype=np.int64)
+        order = np.argsort(original, kind="stable")
+        cells = np.arange(n_owned, dtype=np.int32)[order]
+        beam = np.asarray(mesh.cell_beam[:n_owned], dtype=np.int64)[order]
+        _owned[model] = (cells, original[order], beam)
+    return _owned[model]
 
 
 def nodal_fields(model, recover=True):

@@ -35,6 +35,14 @@ class Progress:
         self.every = every and (min(every, 0.2) if self.tty else every)
         self._last = None
 
+    def due(self):
+        """Would :meth:`update` show a line now? (A caller may skip making its text if not.)"""
+        if not self.active:
+            return False
+        return not (
+            self.every and self._last is not None and time.monotonic() - self._last < self.every
+        )
+
     def update(self, done, text=""):
         """Report ``done`` units finished, with an optional note (e.g. "λ = 0.5, 4 its").
 

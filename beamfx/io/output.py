@@ -220,7 +220,9 @@ class FrameWriter:
         self.policy.resume(t_max)
 
     def close(self):
-        """Close the files that stay open (XDMF)."""
+        """Close the files that stay open (the series' indices, XDMF)."""
+        for series in self.series.values():
+            series.close()
         if self.xdmf is not None:
             self.xdmf.close()
 

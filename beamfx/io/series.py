@@ -17,7 +17,7 @@ import os
 import xml.etree.ElementTree as ET
 from xml.sax.saxutils import quoteattr
 
-from .vtkfiles import summary_template, write_grid, write_summary
+from .vtkfiles import GridWriter, summary_template, write_summary
 
 HEAD = '<?xml version="1.0"?>\n<VTKFile type="Collection" version="1.0" byte_order="LittleEndian">\n<Collection>\n'
 TAIL = "</Collection>\n</VTKFile>\n"
@@ -39,9 +39,11 @@ class PvdIndex:
 
     def __init__(self, path):
         self.path = os.fspath(path)
+        self._file = None  # open for appending from the first append to close()
 
     def create(self, entries=()):
         """Start the file afresh with ``entries`` [(time, file name relative to it)]."""
+        self.close()
         lines = "".join(_line(t, f) for t, f in entries)
         tmp = f"{self.path}.tmp{os.getpid()}"
         with open(tmp, "w", encoding="utf-8") as f:
@@ -50,10 +52,20 @@ class PvdIndex:
 
     def append(self, time, file):
         """Add the frame ``file`` (relative to the index) at ``time``: the closing tags are
-        overwritten by the new line and written again after it."""
-        with open(self.path, "r+b") as f:
-            f.seek(-len(TAIL), os.SEEK_END)
-            f.write((_line(time, file) + TAIL).encode("utf-8"))
+        overwritten by the new line and written again after it, and flushed (the file stays
+        open between frames)."""
+        if self._file is None:
+            self._file = open(self.path, "r+b")  # noqa: SIM115 (closed by close())
+        f = self._file
+        f.seek(-len(TAIL), os.SEEK_END)
+        f.write((_line(time, file) + TAIL).encode("utf-8"))
+        f.flush()
+
+    def close(self):
+        """Close the file (the next :meth:`append` opens it again)."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
 
     def read(self):
         """[(time, file)] of an existing index, [] if there is none."""
@@ -77,6 +89,7 @@ class VtkSeries:
         self.folder, self.stem, self.comm = os.fspath(folder), stem, comm
         self.index = PvdIndex(os.path.join(self.folder, f"{stem}.pvd"))
         self.started, self.template = False, None
+        self.writer = None  # the GridWriter, from the first frame
 
     def _start(self, keep):
         """Keep the frames of an existing index for which ``keep(time)``, delete the files of
@@ -104,19 +117,25 @@ class VtkSeries:
         files of an earlier run's index are removed."""
         if not self.started:
             self._start(lambda t: False)
+        if self.writer is None:
+            self.writer = GridWriter()
         name = f"{self.stem}_{step:04d}"
         if self.comm.size == 1:
             file = f"{name}.vtu"
-            write_grid(os.path.join(self.folder, file), grid)
+            self.writer.write(os.path.join(self.folder, file), grid)
         else:
             file = f"{name}.pvtu"
-            write_grid(os.path.join(self.folder, f"{name}_{self.comm.rank}.vtu"), grid)
+            self.writer.write(os.path.join(self.folder, f"{name}_{self.comm.rank}.vtu"), grid)
             if self.comm.rank == 0:
                 if self.template is None:
                     self.template = summary_template(grid, self.comm.size, self.folder)
                 write_summary(os.path.join(self.folder, file), self.template)
         if self.comm.rank == 0:
             self.index.append(time, file)
+
+    def close(self):
+        """Close the index (rank 0 keeps it open between frames)."""
+        self.index.close()
 
 
 def _remove_frame(path):
