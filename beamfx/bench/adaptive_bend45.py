@@ -37,72 +37,103 @@ def _converged(follower):
     return _reference[follower]
 
 
+def _scene(spec, steps, elements, degree, tolerance):
+    """The scene of a setting, with its ``[accuracy]`` and the model the scene builder picks."""
+    from ..analyses import static_run
+    from ..analyses.trimming import condensed_fit
+    from ..scene.load import Scene
+
+    return Scene(
+        "bench",
+        spec,
+        settings=static_run.Settings(steps=steps),
+        probes={"tip": "b:end"},
+        condense=condensed_fit(spec) is None,  # as the scene builder decides
+        accuracy={
+            "quantity": "tip.position",
+            "tolerance": tolerance,
+            "relative": False,
+            "start_elements": elements,
+            "start_degree": degree,
+            "max_degree": 4,
+            "max_unknowns": 2000,
+        },
+    )
+
+
+def _refine(scene):
+    """(refinement, the model of its last trial, seconds) of :func:`refine_to_tolerance`."""
+    from mpi4py import MPI
+
+    from ..analyses.adaptive import refine_to_tolerance, solve_once
+
+    kept = {}
+
+    def solve(model_spec, scene, comm, probe_at, what):
+        out = solve_once(model_spec, scene, comm, probe_at, what)
+        kept["model"] = out[0]
+        return out
+
+    t0 = time.perf_counter()
+    ref = refine_to_tolerance(scene, MPI.COMM_WORLD, solve=solve)
+    return ref, kept["model"], time.perf_counter() - t0
+
+
+def _warm_solve(model, steps):
+    """(result, seconds) of the static solve of ``model`` again with a solver already used."""
+    from ..analyses.static import solve_static
+    from ..solvers import NewtonSolver
+
+    solver = NewtonSolver(
+        model.F, model.J, model.w, model.bcs, "beamfx_bench_adaptive_", coupling=model.coupling
+    )
+    model.reset()
+    solve_static(model, steps=steps, solver=solver)  # first use of this solver
+    model.reset()
+    t1 = time.perf_counter()
+    warm = solve_static(model, steps=steps, solver=solver)
+    seconds = time.perf_counter() - t1
+    solver.destroy()
+    return warm, seconds
+
+
+def _accuracy(ref, tolerance, follower, per_node):
+    """The ``accuracy`` entry of a row: estimate beside true error, and the criterion model
+    (the last trial but one: the tip moved by less than the tolerance from it)."""
+    x = np.array(ref.trials[-1].value)
+    prev = ref.trials[-2] if len(ref.trials) > 1 else None
+    true_prev = float(np.linalg.norm(np.array(prev.value) - _converged(follower))) if prev else None
+    return {
+        "tolerance": tolerance,
+        "reached": ref.reached,
+        "estimate": ref.estimate,
+        "richardson_estimate": ref.richardson,
+        "true_error": float(np.linalg.norm(x - _converged(follower))),
+        "criterion_model": prev
+        and {
+            "elements": prev.elements,
+            "degree": prev.degree,
+            "unknowns": prev.unknowns,
+            "free_unknowns": prev.unknowns - per_node,
+            "true_error": true_prev,
+        },
+        "trials": [[t.elements, t.degree, t.unknowns, t.change] for t in ref.trials],
+    }
+
+
 @dataclass(frozen=True)
 class AdaptiveCase(Case):
     """Settings are (start elements, start degree, tolerance)."""
 
     def run_setting(self, elements, degree, tolerance):
         """One row of the table: the adaptive refinement from the setting, its value and costs."""
-        from mpi4py import MPI
-
-        from ..analyses import static_run
-        from ..analyses.adaptive import refine_to_tolerance, solve_once
-        from ..analyses.static import solve_static
-        from ..analyses.trimming import condensed_fit
-        from ..scene.load import Scene
-        from ..solvers import NewtonSolver
-
         follower = self.extra["follower"]
         spec, steps = self.build(elements, degree)
-        scene = Scene(
-            "bench",
-            spec,
-            settings=static_run.Settings(steps=steps),
-            probes={"tip": "b:end"},
-            condense=condensed_fit(spec) is None,  # as the scene builder decides
-            accuracy={
-                "quantity": "tip.position",
-                "tolerance": tolerance,
-                "relative": False,
-                "start_elements": elements,
-                "start_degree": degree,
-                "max_degree": 4,
-                "max_unknowns": 2000,
-            },
-        )
-        kept = {}
-
-        def solve(model_spec, scene, comm, probe_at, what):
-            out = solve_once(model_spec, scene, comm, probe_at, what)
-            kept["model"] = out[0]
-            return out
-
-        t0 = time.perf_counter()
-        ref = refine_to_tolerance(scene, MPI.COMM_WORLD, solve=solve)
-        cold = time.perf_counter() - t0
-        model = kept["model"]
-        solver = NewtonSolver(
-            model.F,
-            model.J,
-            model.w,
-            model.bcs,
-            "beamfx_bench_adaptive_",
-            coupling=model.coupling,
-        )
-        model.reset()
-        solve_static(model, steps=steps, solver=solver)  # first use of this solver
-        model.reset()
-        t1 = time.perf_counter()
-        warm = solve_static(model, steps=steps, solver=solver)
-        warm_s = time.perf_counter() - t1
-        solver.destroy()
+        scene = _scene(spec, steps, elements, degree, tolerance)
+        ref, model, cold = _refine(scene)
+        warm, warm_s = _warm_solve(model, steps)
         per_node = 3 if scene.condense else 7  # unknowns of the clamped node
-        last, x = ref.trials[-1], np.array(ref.trials[-1].value)
-        true = float(np.linalg.norm(x - _converged(follower)))
-        prev = ref.trials[-2] if len(ref.trials) > 1 else None
-        true_prev = (
-            float(np.linalg.norm(np.array(prev.value) - _converged(follower))) if prev else None
-        )
+        last = ref.trials[-1]
         return {
             "elements": last.elements,
             "degree": last.degree,
@@ -112,23 +143,8 @@ class AdaptiveCase(Case):
             "model": "statically condensed" if scene.condense else "full",
             "wall_s_cold": cold,
             "wall_s_warm": warm_s,
-            "values": _measure({"tip": {"position": x.tolist()}}),
-            "accuracy": {
-                "tolerance": tolerance,
-                "reached": ref.reached,
-                "estimate": ref.estimate,
-                "richardson_estimate": ref.richardson,
-                "true_error": true,
-                "criterion_model": prev
-                and {
-                    "elements": prev.elements,
-                    "degree": prev.degree,
-                    "unknowns": prev.unknowns,
-                    "free_unknowns": prev.unknowns - per_node,
-                    "true_error": true_prev,
-                },
-                "trials": [[t.elements, t.degree, t.unknowns, t.change] for t in ref.trials],
-            },
+            "values": _measure({"tip": {"position": np.array(last.value).tolist()}}),
+            "accuracy": _accuracy(ref, tolerance, follower, per_node),
         }
 
 

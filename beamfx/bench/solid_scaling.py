@@ -91,20 +91,19 @@ def _fmt_parts(r):
     return " + ".join(f"{p[k]:.1f}" for k in ("assembly", "gamg_setup", "cg", "other"))
 
 
-def report(folder):
-    """solid_scaling.md and .json in ``folder`` from its solid_large_np*.json files."""
-    from .solid import sm21_beam
-
-    folder = Path(folder)
+def _runs(folder):
+    """{ranks: the ``large`` entry} of the solid_large_np*.json files in ``folder``."""
     runs = {}
     for f in sorted(folder.glob("solid_large_np*.json")):
         r = json.loads(f.read_text())["large"]
         runs[r["ranks"]] = r
     if 1 not in runs or 2 not in runs:
         raise SystemExit(f"{folder}: needs solid_large_np1.json and solid_large_np2.json (run)")
-    one, two = runs[1], runs[2]
-    beam, beam_cost = sm21_beam()
-    N = one["unknowns"]
+    return runs
+
+
+def _measured_lines(runs, N):
+    """The title, the set-up and the table of the measured runs."""
     lines = [
         "# The 3D solid at 231k unknowns on 1 and 2 ranks, beside the beam",
         "",
@@ -130,6 +129,11 @@ def report(folder):
             f"| {' / '.join(f'{m:.0f}' for m in r['max_rss_MiB'])} "
             f"| {1e6 * s['solve'] / r['unknowns']:.0f} |"
         )
+    return lines
+
+
+def _speedup_lines(one, two, N):
+    """The speed-up from 1 to 2 ranks and the memory paragraph."""
     speedup = {
         k: one["seconds_in_solve"][k] / two["seconds_in_solve"][k]
         for k in ("assembly", "gamg_setup", "cg")
@@ -138,7 +142,7 @@ def report(folder):
         two["seconds_in_solve"]["cg"] / two["krylov_iterations"]
     )
     total = one["seconds"]["solve"] / two["seconds"]["solve"]
-    lines += [
+    return [
         "",
         (
             f"Measured speed-up from 1 to 2 ranks: solve {total:.2f}; assembly "
@@ -160,6 +164,12 @@ def report(folder):
             f"{1024 * sum(one['max_rss_MiB']) / N:.1f} KiB per unknown on 1 rank, "
             f"{1024 * sum(two['max_rss_MiB']) / N:.1f} KiB per unknown summed over 2 ranks."
         ),
+    ]
+
+
+def _projection_lines(one, two, N):
+    """(lines, {ranks: (low, high)}) of the projection to more ranks."""
+    lines = [
         "",
         "## Projection to more ranks (not measured)",
         "",
@@ -179,7 +189,13 @@ def report(folder):
         low, high = project(one, two, p)
         projections[p] = (low, high)
         lines.append(f"| {p} | {low:.1f} – {high:.1f} | {N // p:,} |")
-    lines += [
+    return lines, projections
+
+
+def _beam_lines(runs, beam, beam_cost):
+    """(lines, relative differences solid − beam) of the beam beside the solid."""
+    one, two = runs[1], runs[2]
+    lines = [
         "",
         "## The beam for the same probes",
         "",
@@ -205,7 +221,22 @@ def report(folder):
         f"{two['wall_s'] / beam_cost['wall_s']:.0f} times the beam's whole run (mesh, forms, "
         "solve) on one.",
     ]
-    (folder / "solid_scaling.md").write_text("\n".join(lines) + "\n")
+    return lines, diff
+
+
+def report(folder):
+    """solid_scaling.md and .json in ``folder`` from its solid_large_np*.json files."""
+    from .solid import sm21_beam
+
+    folder = Path(folder)
+    runs = _runs(folder)
+    one, two = runs[1], runs[2]
+    beam, beam_cost = sm21_beam()
+    N = one["unknowns"]
+    lines = _measured_lines(runs, N) + _speedup_lines(one, two, N)
+    projection, projections = _projection_lines(one, two, N)
+    beam_part, diff = _beam_lines(runs, beam, beam_cost)
+    (folder / "solid_scaling.md").write_text("\n".join(lines + projection + beam_part) + "\n")
     summary = {
         "runs": runs,
         "beam": {**beam, **beam_cost},

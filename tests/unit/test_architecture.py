@@ -23,8 +23,6 @@ KNOWN = {
     "long_functions": [
         "beamfx/analyses/continuation.py::trace_path",
         "beamfx/analyses/transient.py::solve_transient",
-        "beamfx/bench/adaptive_bend45.py::AdaptiveCase.run_setting",
-        "beamfx/bench/solid_scaling.py::report",
     ],
 }
 
