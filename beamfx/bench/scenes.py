@@ -20,6 +20,14 @@ def case_scene(case, elements, degree, analysis="static", **settings):
     )
 
 
+def setting_scene(case, setting):
+    """The scene of a setting of a case: a transient case's own (elements, degree, dt), else
+    :func:`case_scene` of (elements, degree)."""
+    if hasattr(case, "scene"):
+        return case.scene(*setting)
+    return case_scene(case, *setting[:2])
+
+
 def run_in_process(scene, folder):
     """``beamfx run`` of ``scene`` in this process (output written to ``folder``), quiet;
     returns the :class:`~beamfx.runner.RunResult` and the whole run's wall time."""

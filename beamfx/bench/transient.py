@@ -8,7 +8,6 @@ the hub, and the mean axial stretch over 15–18 s, which the hand formula
 ρA Ω² L³ / (3 EA) must match.
 """
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,42 +68,92 @@ def _run(model_spec, settings, probe):
     return model, history, result
 
 
+def scene_settings(settings):
+    """The ``[analysis]`` of a transient scene with the integrator's ``settings`` (a
+    :class:`~beamfx.analyses.transient.TransientSettings`); output and checkpoints as a scene
+    that does not set them (frames: about 200 per run, a checkpoint every 50 steps)."""
+    from ..analyses.transient_run import Damping, Settings
+
+    return Settings(
+        t_end=settings.t_end,
+        dt=settings.dt,
+        scheme=settings.scheme,
+        rho_inf=settings.rho_inf,
+        hht_alpha=settings.hht_alpha,
+        dt_min=settings.dt_min,
+        tolerance=settings.tolerance,
+        damping=Damping(settings.damping_mass, settings.damping_stiffness),
+        rotary_inertia=settings.rotary_inertia,
+    )
+
+
+def read_history(folder, probe):
+    """[(t, position of ``probe``, its unwrapped rotation about z (the planar angle of an xy
+    model), energy record)] from the ``probes.jsonl`` of a transient run in ``folder``."""
+    import json
+    from pathlib import Path
+
+    out = []
+    with open(Path(folder) / "probes.jsonl", encoding="utf-8") as f:
+        for line in f:
+            row = json.loads(line)
+            p = row["probes"][probe]
+            angle = p["rotation_vector_unwrapped"][2]
+            out.append((row["time"], np.array(p["position"]), angle, row["energy"]))
+    return out
+
+
 @dataclass(frozen=True)
 class TransientCase(Case):
     """Settings are (elements, degree, dt); ``build`` returns (model spec, TransientSettings
-    at that dt) and ``measure`` takes the probe history [(t, values)]. ``series`` turns the
-    history into the time series kept for the report's plot (``{label (unit): values}``;
-    default: the tip position)."""
+    at that dt) and ``measure`` takes the probe history [(t, position, planar angle, energy)]
+    (:func:`read_history`) and the model spec. ``series`` turns the history into the time
+    series kept for the report's plot (``{label (unit): values}``; default: the tip position).
+
+    A setting runs as the scene a user would write (:meth:`scene`) through ``beamfx run``'s
+    path in-process, twice (cold, then warm), output written as the scene asks."""
 
     series: object = None
 
-    def run_setting(self, elements, degree, dt):
-        """One row of the table: the measured values, unknowns and cold and warm wall times."""
-        from ..solvers.forms import compile_seconds
-        from .profiling import per_iteration
+    def scene(self, elements, degree, dt):
+        """The scene of a setting, as ``beamfx run`` takes it (built in code)."""
+        from ..scene.load import Scene
 
         spec, settings = self.build(elements, degree, dt)
-        c0, t0 = compile_seconds[0], time.perf_counter()
-        model, history, result = _run(spec, settings, self.probes["tip"])
-        cold = time.perf_counter() - t0
-        jit = compile_seconds[0] - c0
-        t1 = time.perf_counter()
-        _, _, warm_result = _run(spec, settings, self.probes["tip"])
-        warm = time.perf_counter() - t1
+        return Scene(f"bench:{self.id}", spec, "transient", dict(self.probes),
+                     settings=scene_settings(settings))  # fmt: skip
+
+    def run_setting(self, elements, degree, dt):
+        """One row of the table: the measured values, unknowns, cold and warm whole runs and
+        the warm run's solve-only time."""
+        import tempfile
+
+        from ..solvers.forms import compile_seconds
+        from .profiling import per_iteration
+        from .run import newton_seconds
+        from .scenes import run_in_process
+
+        scene = self.scene(elements, degree, dt)
+        with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
+            c0 = compile_seconds[0]
+            run, cold = run_in_process(scene, folder)
+            jit = compile_seconds[0] - c0
+            warm_run, warm = run_in_process(scene, folder)
+            history = read_history(folder, self.probes["tip"])
+        result = warm_run.result
         return {
             "elements": elements,
             "degree": degree,
             "dt": dt,
-            "unknowns": model.unknowns(),
+            "unknowns": run.model["unknowns"],
             "newton_iterations": result.newton_iterations,
-            "load_steps": len(result.steps),
+            "load_steps": result.time_steps,
             "wall_s_cold": cold,
-            "wall_s_warm": warm,
+            "wall_s_whole": warm,
+            "wall_s_warm": newton_seconds(result.seconds),
             "jit_s": jit,
-            "warm_per_iteration_s": per_iteration(
-                warm_result.seconds, warm_result.newton_iterations
-            ),
-            "values": {k: float(v) for k, v in self.measure(history, model).items()},
+            "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
+            "values": {k: float(v) for k, v in self.measure(history, scene.model).items()},
             "history": _thinned((self.series or tip_series)(history)),
         }
 
@@ -136,7 +185,7 @@ def spin_up_series(history):
     }
 
 
-def spin_up_measure(history, model=None):
+def spin_up_measure(history, spec=None):
     """Spin-up quantities from the (t, tip position, planar angle) history: least axial and
     transverse tip displacement in the rotating frame, least relative rotation, mean stretch over
     15–18 s."""
@@ -231,14 +280,15 @@ def bend45_settings(dt):
     )
 
 
-def bend45_measure(history, model):
-    """The tip position at 60 s, and its distance to the static answer of the same mesh."""
+def bend45_measure(history, spec):
+    """The tip position at 60 s, and its distance to the static answer of the same mesh
+    (``spec``: the model spec)."""
     from ..analyses.model import BeamModel
     from ..analyses.static import solve_static
     from ..io import evaluate_points
 
     tip = np.array(history[-1][1])
-    static = BeamModel(model.spec, extra_points=["b:end"])
+    static = BeamModel(spec, extra_points=["b:end"])
     solve_static(static, steps=10)
     x = np.array(evaluate_points(static, ["b:end"])["b:end"]["position"])
     return {"x": tip[0], "y": tip[1], "z": tip[2], "distance_to_static": np.linalg.norm(tip - x)}
@@ -298,7 +348,7 @@ def flying_settings(dt):
     return TransientSettings(t_end=40.0, dt=dt, scheme="conserving", checkpoint_every=0)
 
 
-def flying_measure(history, model=None):
+def flying_measure(history, spec=None):
     """Drift over the free flight (t > 5 s) of the energy and the momenta, relative to the
     energy and to |L| + 10 |p| (10: the beam's length); exact conservation is 0."""
     free = [h[3] for h in history if h[0] > 5.0 + 1e-9]
