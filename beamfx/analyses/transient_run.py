@@ -237,12 +237,13 @@ def _entry_time(line):
 def _start(model, settings, ctx):
     """The checkpoint to go on from (restart), else a static start if asked; the checkpoint."""
     from .restart import load_restart
-    from .static import solve_static
 
     saved = load_restart(ctx, settings, model) if ctx.restart else None
     if ctx.restart and saved is None:
         ctx.log("note: no checkpoint for this number of ranks; starting from t = 0")
     if saved is None and settings.start == "static":
+        from .static import solve_static
+
         model.set_time(0.0)
         opts = ctx.solver_options
         static = solve_static(model, steps=settings.steps, options=opts, log=ctx.log)
