@@ -278,19 +278,26 @@ def test_resume_keeps_earlier_frames_and_drops_later_ones(half_circle, tmp_path)
     if comm.rank == 0:
         assert [t for t, _ in pvd_entries(index)] == [0.25, 0.5]
         assert os.path.exists(frame_file(folder, "deformed", 2))
-        assert not os.path.exists(frame_file(folder, "deformed", 3))
-        assert not [n for n in os.listdir(folder) if n.startswith("deformed_0004")]
     comm.barrier()
-    restarted.write(3, 0.75)
+    restarted.write(3, 0.75)  # overwrites the dropped frame of the same name
+    restarted.close()  # deletes the dropped frames not written again
     comm.barrier()
     if comm.rank == 0:
         assert [t for t, _ in pvd_entries(index)] == [0.25, 0.5, 0.75]
+        assert os.path.exists(frame_file(folder, "deformed", 3))
+        assert not [n for n in os.listdir(folder) if n.startswith("deformed_0004")]
+    comm.barrier()
     fresh = FrameWriter(folder, model, settings, model.spec.beams, comm)  # a new run
     fresh.write(1, 1.0)
     comm.barrier()
     if comm.rank == 0:
         assert [t for t, _ in pvd_entries(index)] == [1.0]
-        assert not os.path.exists(frame_file(folder, "deformed", 2))  # the old run's files
+    fresh.close()
+    comm.barrier()
+    if comm.rank == 0:  # the old run's files, rewritten (1) or deleted (2, 3)
+        frames = [n for n in os.listdir(folder) if n.startswith("deformed_")]
+        assert os.path.basename(frame_file(folder, "deformed", 1)) in frames
+        assert all(n.startswith("deformed_0001") for n in frames), frames
 
 
 def _frames(policy, times):
