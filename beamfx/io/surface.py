@@ -28,6 +28,7 @@ VTK_QUAD rings) as end caps, at the first and last element of each beam only, so
 pieces of several ranks (each its own elements) together make the surface of one rank.
 """
 
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -102,7 +103,7 @@ def refine(fields, degree, subdivisions=4):
     """
     k = degree
     n_el = len(fields["X"]) // (k + 1)
-    A = lagrange_matrix(np.linspace(0, 1, k + 1), np.linspace(0, 1, subdivisions + 1))
+    A = _refinement_matrix(k, subdivisions)
 
     def per_element(a):
         return np.einsum("sn,en...->es...", A, np.asarray(a).reshape(n_el, k + 1, -1))
@@ -115,6 +116,15 @@ def refine(fields, degree, subdivisions=4):
     beam = np.asarray(fields["beam"])
     out["beam"] = (beam if len(beam) == n_el else beam.reshape(n_el, k + 1)[:, 0]).astype(np.int64)
     return out
+
+
+@lru_cache(maxsize=8)
+def _refinement_matrix(degree, subdivisions):
+    """Values of an element's k + 1 Lagrange polynomials at its ``subdivisions`` + 1 samples
+    (cached, read only: every frame asks for the same)."""
+    A = lagrange_matrix(np.linspace(0, 1, degree + 1), np.linspace(0, 1, subdivisions + 1))
+    A.flags.writeable = False
+    return A
 
 
 class SurfaceMesh(NamedTuple):
