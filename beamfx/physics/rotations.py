@@ -4,6 +4,8 @@ Quaternions are ``(q0, q1, q2, q3)`` with scalar part first. ``R(q)`` maps secti
 to global (spatial) vectors.
 """
 
+import math
+
 import numpy as np
 
 
@@ -152,6 +154,17 @@ def unwrap_rotation_vector(q, previous):
     axis, angle = axis_angle(q)
     prev = np.asarray(previous, dtype=float)
     k0 = int(np.ceil(np.linalg.norm(prev) / (2 * np.pi)))
-    turns = np.arange(-k0 - 2, k0 + 3)
-    candidates = (angle + 2 * np.pi * turns)[:, None] * np.asarray(axis, float)[None, :]
-    return candidates[np.argmin(np.linalg.norm(candidates - prev, axis=1))]
+    # |(φ + 2πk) n - prev| is least at the integer nearest to (n·prev - φ)/2π: of the turns
+    # -k0-2 .. k0+2 only that one and its neighbours are compared, in plain floats (the same
+    # operations as arrays of all the turns would do, at a tenth of the cost per call)
+    n, p = [float(x) for x in axis], [float(x) for x in prev]
+    centre = round((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - angle) / (2 * np.pi))
+    best = None
+    for k in range(max(centre - 1, -k0 - 2), min(centre + 1, k0 + 2) + 1):
+        c = angle + 2 * np.pi * k
+        x = [c * n[0], c * n[1], c * n[2]]
+        d = [x[0] - p[0], x[1] - p[1], x[2] - p[2]]
+        dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        if best is None or dist < best[0]:
+            best = (dist, x)
+    return np.array(best[1])
