@@ -430,6 +430,86 @@ def _begin(saved, dyn, balance, control, on_step, log):
     return 0.0, 0
 
 
+class _March(NamedTuple):
+    """What every step of a march uses."""
+
+    model: object
+    settings: TransientSettings
+    dyn: Dynamics
+    solver: NewtonSolver
+    balance: EnergyBalance
+    projection: object  # the conserving scheme's Projection, or None
+    dt_min: float
+    length: float  # the scale of the displacements, for the error estimate
+    log: object
+
+
+def _step(m, control, t, failed):
+    """Newton from ``t`` at the control's step size, cut back until a step is accepted:
+    (h, the size wanted before the end time shortened it, report, cut-backs, error estimate or
+    None); ``model.w`` then holds q_{n+1}.
+
+    Raises:
+        TransientFailed: below the smallest step size, after ``failed()`` (the checkpoint).
+    """
+    s, model, dyn = m.settings, m.model, m.dyn
+    wanted = control.size  # kept if only the end time shortens this step
+    h = control.size = min(wanted, s.t_end - t)
+    cutbacks, tried, error = 0, [], None
+    while True:
+        dyn.h.value = h
+        model.set_time(t + h)
+        dyn.predict(h)
+        report = m.solver.solve()
+        if report.converged and s.tolerance:
+            error = dyn.error_estimate(h, s.tolerance, m.length)
+            if error <= 1.0 or h <= m.dt_min * (1 + 1e-9):
+                return h, wanted, report, cutbacks, error
+            reason_ = f"local error {error:.3g} x tolerance"
+            tried.append((h, reason_, report.residuals))
+            model.w.x.array[:] = dyn.q_n.x.array
+            h, cutbacks = control.rejected(error), cutbacks + 1
+            continue
+        if report.converged:
+            return h, wanted, report, cutbacks, error
+        tried.append((h, report.reason, report.residuals))
+        model.w.x.array[:] = dyn.q_n.x.array
+        cutbacks += 1
+        try:
+            h = control.rejected()
+        except StepTooSmall:
+            failed()
+            raise TransientFailed(_failure(t, m.dt_min, tried)) from None
+        m.log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
+
+
+def _accept(m, t, h, q_old):
+    """Move the state on from ``t`` to t + h after a converged step (``q_old`` gets q_n);
+    returns the energy balance at t + h."""
+    q_old[:] = m.dyn.q_n.x.array
+    m.balance.reactions()
+    m.dyn.accept(h)
+    if m.projection:
+        m.projection.apply(t, t + h)
+    return m.balance.record(q_old, h)
+
+
+def _march(model, s, options, prefix, log):
+    """The :class:`_March` of ``model`` with ``settings`` ``s``, and the forms' compile time."""
+    from ..solvers.forms import compile_seconds
+
+    c0 = compile_seconds[0]
+    dyn = Dynamics(model, s)
+    solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
+    solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
+    balance = EnergyBalance(dyn, solver.F)
+    projection = Projection(dyn, balance) if s.scheme == "conserving" else None
+    dt_min = s.dt_min or s.dt / 1000
+    length = model_size(model.spec)
+    m = _March(model, s, dyn, solver, balance, projection, dt_min, length, log or (lambda _: None))
+    return m, compile_seconds[0] - c0
+
+
 def solve_transient(
     model,
     settings,
@@ -459,70 +539,30 @@ def solve_transient(
             last good state was checkpointed.
     """
     from ..interrupt import pending, reason
-    from ..solvers.forms import compile_seconds
 
-    t_start, c0 = time.perf_counter(), compile_seconds[0]
-    s = settings
-    dyn = Dynamics(model, s)
-    solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
-    solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
-    balance = EnergyBalance(dyn, solver.F)
-    projection = Projection(dyn, balance) if s.scheme == "conserving" else None
-    compile_time = compile_seconds[0] - c0
-    dt_min = s.dt_min or s.dt / 1000
-    length = model_size(model.spec)  # the scale of the displacements
-    log = log or (lambda msg: None)
+    t_start, s = time.perf_counter(), settings
+    m, compile_time = _march(model, s, options, prefix, log)
+    dyn, balance, solver = m.dyn, m.balance, m.solver
     growth = ErrorBased() if s.tolerance else EasyGrowth(1.5, s.easy_iterations, 2, clean=True)
-    control = StepControl(s.dt, s.dt, dt_min, growth)
+    control = StepControl(s.dt, s.dt, m.dt_min, growth)
 
     def save(t, step):
         if checkpoint:
             checkpoint(*checkpoint_state(dyn, balance, control, t, step))
 
     model.set_load_factor(1.0)
-    t, step = _begin(saved, dyn, balance, control, on_step, log)
-    if projection:
-        projection.remember()
-    records, iterations, error, stopped_by = [], 0, None, "t_end"
+    t, step = _begin(saved, dyn, balance, control, on_step, m.log)
+    if m.projection:
+        m.projection.remember()
+    records, iterations, stopped_by = [], 0, "t_end"
     q_old = model.w.x.array.copy()
     while t < s.t_end * (1 - 1e-12):
-        wanted = control.size  # kept if only the end time shortens this step
-        h = control.size = min(wanted, s.t_end - t)
-        cutbacks, tried = 0, []
-        while True:
-            dyn.h.value = h
-            model.set_time(t + h)
-            dyn.predict(h)
-            report = solver.solve()
-            if report.converged and s.tolerance:
-                error = dyn.error_estimate(h, s.tolerance, length)
-                if error <= 1.0 or h <= dt_min * (1 + 1e-9):
-                    break
-                reason_ = f"local error {error:.3g} x tolerance"
-                tried.append((h, reason_, report.residuals))
-                model.w.x.array[:] = dyn.q_n.x.array
-                h, cutbacks = control.rejected(error), cutbacks + 1
-                continue
-            if report.converged:
-                break
-            tried.append((h, report.reason, report.residuals))
-            model.w.x.array[:] = dyn.q_n.x.array
-            cutbacks += 1
-            try:
-                h = control.rejected()
-            except StepTooSmall:
-                save(t, step)
-                raise TransientFailed(_failure(t, dt_min, tried)) from None
-            log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
-        q_old[:] = dyn.q_n.x.array
-        balance.reactions()
-        dyn.accept(h)
-        if projection:
-            projection.apply(t, t + h)
-        t, step, iterations = t + h, step + 1, iterations + report.iterations
-        record = StepRecord(
-            step, t, h, report.iterations, report.residuals, cutbacks, balance.record(q_old, h)
+        h, wanted, report, cutbacks, error = _step(
+            m, control, t, lambda t=t, step=step: save(t, step)
         )
+        energy = _accept(m, t, h, q_old)
+        t, step, iterations = t + h, step + 1, iterations + report.iterations
+        record = StepRecord(step, t, h, report.iterations, report.residuals, cutbacks, energy)
         records.append(record)
         if on_step:
             on_step(record)

@@ -14,6 +14,12 @@ import time
 _cold = {}  # case id -> seconds of the cold compile of its first setting
 
 
+def newton_seconds(seconds):
+    """The Newton iterations' own time in a solve's split (assembly and linear solves, SNES):
+    the "solve only" figure, without model building, output or probes."""
+    return seconds["assemble_F"] + seconds["assemble_J"] + seconds["solve"]
+
+
 def per_iteration(seconds, iterations):
     """Seconds per Newton iteration of a solve: assembly, LU, triangular solves, the rest
     (Python), from the solve's wall-time split ``seconds``."""

@@ -6,18 +6,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .profiling import per_iteration
+from .profiling import newton_seconds, per_iteration
 
 
 def _error(case, values, ref):
     diffs = [abs(values[k] - ref[k]) / (case.scale or max(abs(ref[k]), 1e-300)) for k in ref]
     return float(max(diffs))
-
-
-def newton_seconds(seconds):
-    """The Newton iterations' own time in a solve's split (assembly and linear solves, SNES):
-    the "solve only" figure, without model building, output or probes."""
-    return seconds["assemble_F"] + seconds["assemble_J"] + seconds["solve"]
 
 
 def run_setting(case, elements, degree):
@@ -269,7 +263,7 @@ def markdown(results, figures=None, note=None):
             "solve) inside that run, labelled as such; cold = the first run in the process (JIT "
             "or cache load included). A setting of several runs (one per target frequency or "
             "load) sums them. Cases marked * still run their own solver path (torque buckling, "
-            "rotating and adaptive cases; the flying spaghetti, a free body): their times are solve-only."
+            "rotating and adaptive cases): their times are solve-only."
         ),
         "",
         (

@@ -111,12 +111,9 @@ class TransientCase(Case):
     series kept for the report's plot (``{label (unit): values}``; default: the tip position).
 
     A setting runs as the scene a user would write (:meth:`scene`) through ``beamfx run``'s
-    path in-process, twice (cold, then warm), output written as the scene asks; with
-    ``as_scene=False`` (a free body, which ``beamfx run`` refuses) through
-    :func:`~beamfx.analyses.transient.solve_transient` alone (its time is then solve-only)."""
+    path in-process, twice (cold, then warm), output written as the scene asks."""
 
     series: object = None
-    as_scene: bool = True
 
     def scene(self, elements, degree, dt):
         """The scene of a setting, as ``beamfx run`` takes it (built in code)."""
@@ -129,13 +126,10 @@ class TransientCase(Case):
     def run_setting(self, elements, degree, dt):
         """One row of the table: the measured values, unknowns, cold and warm whole runs and
         the warm run's solve-only time."""
-        if not self.as_scene:
-            return self._solve_only(elements, degree, dt)
         import tempfile
 
         from ..solvers.forms import compile_seconds
-        from .profiling import per_iteration
-        from .run import newton_seconds
+        from .profiling import newton_seconds, per_iteration
         from .scenes import run_in_process
 
         scene = self.scene(elements, degree, dt)
@@ -159,36 +153,6 @@ class TransientCase(Case):
             "jit_s": jit,
             "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
             "values": {k: float(v) for k, v in self.measure(history, scene.model).items()},
-            "history": _thinned((self.series or tip_series)(history)),
-        }
-
-    def _solve_only(self, elements, degree, dt):
-        """The row of a setting run by :func:`_run` (model and march only), cold and warm."""
-        import time
-
-        from ..solvers.forms import compile_seconds
-        from .profiling import per_iteration
-
-        spec, settings = self.build(elements, degree, dt)
-        c0, t0 = compile_seconds[0], time.perf_counter()
-        model, history, result = _run(spec, settings, self.probes["tip"])
-        cold, jit = time.perf_counter() - t0, compile_seconds[0] - c0
-        t1 = time.perf_counter()
-        _, _, warm_result = _run(spec, settings, self.probes["tip"])
-        warm = time.perf_counter() - t1
-        its = warm_result.newton_iterations
-        return {
-            "elements": elements,
-            "degree": degree,
-            "dt": dt,
-            "unknowns": model.unknowns(),
-            "newton_iterations": result.newton_iterations,
-            "load_steps": len(result.steps),
-            "wall_s_cold": cold,
-            "wall_s_warm": warm,
-            "jit_s": jit,
-            "warm_per_iteration_s": per_iteration(warm_result.seconds, its),
-            "values": {k: float(v) for k, v in self.measure(history, spec).items()},
             "history": _thinned((self.series or tip_series)(history)),
         }
 
@@ -413,7 +377,6 @@ register(
         tolerance=1e-9,
         scale=1.0,
         settings=((8, 2, 0.1), (8, 2, 0.05), (16, 2, 0.05)),
-        as_scene=False,  # a free body: beamfx run asks for supports
         note=(
             "Free beam (EA = GA = 1e4, EI = GJ = 500, ρA = 1) thrown out of its plane; 35 s of "
             "free flight after the 5 s pulse, about 28 periods of the slowest flexible mode "

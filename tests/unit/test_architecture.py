@@ -22,7 +22,6 @@ KNOWN = {
     "import_cycles": [],
     "long_functions": [
         "beamfx/analyses/continuation.py::trace_path",
-        "beamfx/analyses/transient.py::solve_transient",
     ],
 }
 
