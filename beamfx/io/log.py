@@ -36,7 +36,7 @@ class Progress:
         self._last = None
 
     def due(self):
-        """Would :meth:`update` show a line now? (A caller may skip making its text if not.)"""
+        """Whether :meth:`update` would show a line now (a caller may skip making its text)."""
         if not self.active:
             return False
         return not (
