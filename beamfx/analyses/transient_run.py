@@ -276,7 +276,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     a SIGINT or SIGTERM stops it at a step ("stopped", with a checkpoint)."""
     from ..interrupt import deferred
     from .restart import checkpoint_writer
-    from .transient import solve_transient
+    from .transient import TransientFailed, solve_transient
 
     for w in motion_warnings(ctx.spec, settings.t_end):
         ctx.log(f"warning: {w}")
@@ -306,6 +306,9 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
                 checkpoint=checkpoint_writer(ctx, settings, model, history),
                 saved=saved,
             )
+    except TransientFailed:  # collective; the model holds the last accepted state again
+        ctx.probe_values(model)  # its full values, for results.json
+        raise
     finally:
         bar.close()
         history.close()
