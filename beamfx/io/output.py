@@ -202,11 +202,15 @@ class FrameWriter:
         if self._ends is None:  # first and last input cell of every beam, over all ranks
             from mpi4py import MPI
 
-            first = np.full(len(self.names), np.iinfo(np.int64).max)
-            last = np.full(len(self.names), -1)
+            first = np.full(len(self.names), np.iinfo(np.int64).max, dtype=np.int64)
+            last = np.full(len(self.names), -1, dtype=np.int64)
             np.minimum.at(first, fields["beam"], fields["cell"])
             np.maximum.at(last, fields["beam"], fields["cell"])
-            self._ends = (self.comm.allreduce(first, MPI.MIN), self.comm.allreduce(last, MPI.MAX))
+            # element-wise over ranks (the object allreduce compares whole arrays)
+            ends = (np.empty_like(first), np.empty_like(last))
+            self.comm.Allreduce(first, ends[0], MPI.MIN)
+            self.comm.Allreduce(last, ends[1], MPI.MAX)
+            self._ends = ends
         mesh = surface_mesh(fields, self.model.degree, self.names, self.outlines, ends=self._ends)
         return surface_grid(mesh, arrays, self.grids["surface"])
 

@@ -193,9 +193,6 @@ steps = 10
 [[probes]]
 name = "apex"
 at = "a:end"
-
-[output]
-formats = ["vtu"]  # the surface writer fails for two beams on 2 ranks (io/output.py, not here)
 """
 
 
