@@ -15,6 +15,7 @@ from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
 from ..spec import DOF_NAMES
 from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
+from .static import state_sizes
 
 
 class PathPoint(NamedTuple):
@@ -148,6 +149,7 @@ def trace_path(
         options,
         settings,
         norm_dofs=u_dofs,
+        sizes=state_sizes(model),
     )
     compile_time = compile_seconds[0] - c0
 

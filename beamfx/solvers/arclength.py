@@ -57,10 +57,11 @@ import numpy as np
 
 from .assembly import assemble_load, assemble_residual, assemble_tangent
 from .bifurcation import CriticalPoint, classify, locate, smallest_eigenpair
+from .convergence import INCREMENT_TOL, ScaledTest, diagnose, remedy
 from .forms import compile_form
 from .inertia import InertiaCounter, counts_inertia, negative_pivots, prepare
 from .options import petsc_options
-from .snes import SolveFailed
+from .snes import SolveFailed, constrained_rows
 
 #: the bordered system is solved twice per factorisation: a direct solver is the natural fit
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
@@ -75,12 +76,11 @@ class ArcLengthSettings:
         psi: weight ψ of the load term in the constraint (0: cylindrical, 1: spherical).
         follower: the load vector f depends on w (follower loads): re-assemble it every
             iteration as f = F(w, 0) - F(w, 1); otherwise it is assembled once.
-        rtol: converged when ‖R‖ ≤ atol + rtol·‖f‖·max(1, |λ|) (‖f‖: load vector at the
-            start) ...
-        atol: absolute residual tolerance, in the units of the residual.
-        stol: ... or when the last correction is small, ‖δw‖ ≤ stol·‖Δw‖ (Newton converges
-            quadratically, so the error left is O(‖δw‖²)): stiff axial, shear and penalty
-            terms put a round-off floor under ‖R‖ (SNES's CONVERGED_SNORM_RELATIVE).
+        atol: absolute residual tolerance, in the units of the residual; the corrector's
+            convergence test is Newton's (:mod:`beamfx.solvers.convergence`): the residual
+            against the force scale (the load λ·‖f‖ or the reactions), or the round-off
+            floor with small increments (also of λ).
+        rtol: the test's relative criterion (‖R‖ ≤ rtol·‖R₀‖ with small increments); 0: off.
         max_iterations: corrector iterations per step before the step counts as failed.
         divergence: a step fails when ‖R‖ exceeds this multiple of its first residual.
         desired_iterations: I_d of the step-size rule Δl_new = Δl (I_d / I)^½.
@@ -100,9 +100,8 @@ class ArcLengthSettings:
     method: str = "crisfield"
     psi: float = 0.0
     follower: bool = False
-    rtol: float = 1e-9
     atol: float = 0.0
-    stol: float = 1e-8
+    rtol: float = 0.0
     max_iterations: int = 12
     divergence: float = 1e6
     desired_iterations: int = 5
@@ -140,7 +139,8 @@ class ArcLengthResult(NamedTuple):
 
 
 class _StepFailed(Exception):
-    pass
+    """A failed step: args (why, residuals, cause, detail); the cause is a key of
+    :data:`~beamfx.solvers.convergence.REMEDIES`."""
 
 
 @dataclass
@@ -154,7 +154,7 @@ class _Path:
     control: object  # StepControl of Δl
     steps: list
     critical: list
-    tried: list  # (Δl, why, residuals) of the failed attempts at the next step
+    tried: list  # (Δl, why, residuals, detail) of the failed attempts at the next step
     switched: bool = False
 
 
@@ -172,10 +172,22 @@ class ArcLengthSolver:
         settings: :class:`ArcLengthSettings`.
         norm_dofs: local indices (of ``w.x.array``) of the dofs measured by the arc length
             (the matrix S); None measures all dofs.
+        sizes: per owned unknown, the size added to |x| in the round-off floor estimate
+            (:meth:`~beamfx.solvers.snes.NewtonSolver.set_sizes`); None: none.
     """
 
     def __init__(
-        self, F, J, w, load_factor, bcs, prefix, options=None, settings=None, norm_dofs=None
+        self,
+        F,
+        J,
+        w,
+        load_factor,
+        bcs,
+        prefix,
+        options=None,
+        settings=None,
+        norm_dofs=None,
+        sizes=None,
     ):
         import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
@@ -195,7 +207,14 @@ class ArcLengthSolver:
         self.R, self.f = fp.create_vector(self.F), fp.create_vector(self.F)
         self.dw_R, self.dw_f = self.R.duplicate(), self.R.duplicate()
         self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0}
-        self.seconds.update(inertia=0.0, locate=0.0)
+        self.seconds.update(inertia=0.0, locate=0.0, test=0.0)
+        # what Newton's convergence test reads (ScaledTest): the tangent, tolerances, the
+        # force scale λ·‖f‖ and the reactions of the iterate, the sizes of the floor estimate
+        self.b, self.atol, self.rtol = self.R, self.settings.atol, self.settings.rtol
+        self.force_scale, self.reactions = 0.0, 0.0
+        self.sizes = None if sizes is None else np.asarray(sizes, float)
+        self._rows = constrained_rows(bcs, self.R.getLocalSize())
+        self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
         self._cached, self._prepared = None, False
 
@@ -226,7 +245,8 @@ class ArcLengthSolver:
         """R(w, λ) with zero rows on the constrained dofs (w satisfies the bcs)."""
         t = time.perf_counter()
         self.lam.value = lam
-        assemble_residual(self.R, self.F, self.J, self.bcs, self.w.vector)
+        local = assemble_residual(self.R, self.F, self.J, self.bcs, self.w.vector, self._rows)
+        self.reactions = float(np.sqrt(self.comm.allreduce(local)))
         self.seconds["assemble_F"] += time.perf_counter() - t
         return self.R.norm()
 
@@ -321,7 +341,7 @@ class ArcLengthSolver:
         t.scale(dlam)
         return t, dlam
 
-    def _step(self, lam_n, dl, direction, land_at=None, inject=None):
+    def _step(self, lam_n, dl, direction, land_at=None, inject=None, deflate=None):
         """Corrector iterations of one step from the current (converged) state (w_n, λ_n).
 
         Args:
@@ -332,6 +352,10 @@ class ArcLengthSolver:
                 ``direction = (Δw, Δλ)`` scaled onto it.
             inject: predictor Δw = ξ·inject with Δλ = 0, scaled to the arc length ``dl``
                 (mode injection onto a secondary branch).
+            deflate: a unit vector φ (the null vector near a bifurcation): the corrections
+                have their φ components removed, so the iterates stay on the primary path
+                where K is nearly singular (its round-off would move them along φ by
+                floor/μ).
 
         Returns:
             (Δw, Δλ, iterations, residuals); w and λ hold the new point.
@@ -340,37 +364,59 @@ class ArcLengthSolver:
         dw, dlam = self._predict(lam_n, dl, direction, land_at, inject)
         dw0, dlam0 = dw.copy(), dlam
         self._add(dw)
-
-        residuals, small = [], False
+        self.test.reset()
+        residuals, ddlam = [], 0.0
         for it in range(s.max_iterations + 1):
             residuals.append(self._residual(lam_n + dlam))
-            tol = s.atol + s.rtol * self.f_norm * max(1.0, abs(lam_n + dlam))
-            if residuals[-1] <= tol or small:
+            if self._converged(it, residuals[-1], lam_n + dlam, ddlam):
                 return dw, dlam, it, tuple(residuals)
-            if not np.isfinite(residuals[-1]) or residuals[-1] > s.divergence * max(
-                residuals[0], tol
-            ):
-                raise _StepFailed("diverged", tuple(residuals))
+            if residuals[-1] > s.divergence * residuals[0]:
+                raise self._failed("DIVERGED_DTOL", "diverged", residuals)
             if it == s.max_iterations:
                 break
             try:
                 self._factor(lam_n + dlam)
                 self._solve(self.R, self.dw_R, scale=-1.0)
-                if land_at is not None:
-                    ddlam = 0.0
-                else:
+                _deflate(self.dw_R, deflate)
+                if land_at is None:
                     if s.follower:
                         self._load()
                     self._solve(self.f, self.dw_f)
+                    _deflate(self.dw_f, deflate)
                     ddlam = self._constraint(dw, dlam, dw0, dlam0, dl)
             except _StepFailed as e:
-                raise _StepFailed(e.args[0], tuple(residuals)) from None
+                raise _StepFailed(e.args[0], tuple(residuals), "linear solve", e.args[0]) from None
             self.dw_R.axpy(ddlam, self.dw_f)
             dw.axpy(1.0, self.dw_R)
-            small = self.dw_R.norm() <= s.stol * dw.norm()
             dlam += ddlam
             self._add(self.dw_R)
-        raise _StepFailed(f"no convergence in {s.max_iterations} iterations", tuple(residuals))
+        raise self._failed(
+            "DIVERGED_MAX_IT", f"no convergence in {s.max_iterations} iterations", residuals
+        )
+
+    def _converged(self, it, fnorm, lam, ddlam):
+        """Newton's convergence test (:class:`~beamfx.solvers.convergence.ScaledTest`) at
+        iteration ``it`` of a step, whose last correction is (δw = ``dw_R``, δλ = ``ddlam``):
+        the force scale is the load λ·‖f‖; the floor and relative criteria also need a small
+        δλ. Raises _StepFailed on a non-finite residual."""
+        t = time.perf_counter()
+        self.force_scale = abs(lam) * self.f_norm
+        x = self.w.vector
+        norms = (x.norm(), self.dw_R.norm() if it else 0.0, fnorm)
+        how = self.test.check(it, norms, self.R, self.dw_R if it else None, x)
+        if how in ("floor", "relative") and abs(ddlam) > INCREMENT_TOL * abs(lam):
+            how = self.test.how = None
+        self.seconds["test"] += time.perf_counter() - t
+        if how == "nan":
+            raise self._failed("DIVERGED_FNORM_NAN", "the residual is not finite", [fnorm])
+        return how is not None
+
+    def _failed(self, reason, why, residuals):
+        """_StepFailed of a corrector that stopped with the PETSc-named ``reason``: the cause
+        and its numbers by :func:`~beamfx.solvers.convergence.diagnose`."""
+        floor = self.test.absolute.floor(self.A, self.w.vector, self.sizes)
+        cause, detail = diagnose(reason, self.test.records, floor)
+        return _StepFailed(f"{why}: {cause}", tuple(residuals), cause, detail)
 
     def _constraint(self, dw, dlam, dw0, dlam0, dl):
         """δλ of the bordered system (Crisfield's quadratic or Riks' normal plane)."""
@@ -496,15 +542,19 @@ class ArcLengthSolver:
             return self._step(path.lam, dl, path.direction)
         except _StepFailed as e:
             self._restore(saved, path.lam)
-            path.tried.append((dl, e.args[0], e.args[1] if len(e.args) > 1 else ()))
+            why, residuals, cause, detail = (*e.args, (), None, None)[:4]
+            path.tried.append((dl, why, residuals, detail))
             if log:
                 n = len(path.steps) + 1
-                log(f"step {n}: arc length {dl:.4g} failed ({e.args[0]}); halving it")
+                log(f"step {n}: arc length {dl:.4g} failed ({why}); halving it")
             try:
                 path.control.rejected()
             except StepTooSmall:
                 failure = self._failure(len(path.steps) + 1, path.lam, path.tried)
-                raise SolveFailed(failure, path.steps) from None
+                details = {"cause": cause, "detail": detail, "load_factor": path.lam}
+                raise SolveFailed(
+                    failure, path.steps, cause, arc_remedy(cause), details=details
+                ) from None
             return None
 
     def _accept(self, path, saved, taken, on_step, log):
@@ -628,7 +678,9 @@ class ArcLengthSolver:
         end_vec, lam_end, dl = end
         phi = self.R.duplicate()
         rng = np.random.default_rng(self.comm.rank)
-        phi.setArray(rng.standard_normal(phi.getLocalSize()))
+        start = rng.standard_normal(phi.getLocalSize())
+        start[self._rows] = 0.0  # the constrained dofs' unit eigenvalues are not the structure's
+        phi.setArray(start)
         last = {}
 
         def probe(x):
@@ -637,7 +689,9 @@ class ArcLengthSolver:
                 lam = lam_end
             else:
                 self._restore(saved, path.lam)
-                lam = path.lam + (self._step(path.lam, x, path.direction)[1] if x else 0.0)
+                lam = path.lam
+                if x:
+                    lam += self._step(path.lam, x, path.direction, deflate=phi)[1]
             self._factor(lam)
             count = self._count()
             mu, _ = smallest_eigenpair(self.A, self._solve, phi)
@@ -679,6 +733,8 @@ class ArcLengthSolver:
         count, forward = self._at_state(lam_c + dlam, (dw, dlam))
         length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
         self._record(path, taken, length, count, forward, on_step, log, note="branch switch")
+        # the secondary branch has its own scale: the step sizes start again from this step's
+        path.control = self._control(length)
 
     def _land(self, saved, lam, dw, dlam, target):
         """Redo the step that crossed ``target`` at fixed λ = target; None if that fails."""
@@ -704,8 +760,10 @@ class ArcLengthSolver:
     @staticmethod
     def _failure(step, lam, tried):
         lines = "\n".join(
-            f"  arc length {dl:.4g}: {why}, |R| = " + ", ".join(f"{r:.3e}" for r in res)
-            for dl, why, res in tried
+            f"  arc length {dl:.4g}: {why}, |R| = "
+            + ", ".join(f"{r:.3e}" for r in res)
+            + (f" ({detail})" if detail else "")
+            for dl, why, res, detail in tried
         )
         return (
             f"arc-length continuation failed at step {step} after {len(tried)} attempts, the "
@@ -714,9 +772,32 @@ class ArcLengthSolver:
 
     def destroy(self):
         """Free the solver's PETSc objects."""
+        self.test.destroy()
         for obj in (self.ksp, self.A, self.R, self.f, self.dw_R, self.dw_f):
             obj.destroy()
         if self._counter is not None:
             self._counter.destroy()
         if self._cached is not None:
             self._cached.destroy()
+
+
+def _deflate(v, phi):
+    """Remove the φ component of v: v ← v − (φ·v) φ, φ a unit vector (nothing for None)."""
+    if phi is not None:
+        v.axpy(-v.dot(phi), phi)
+
+
+#: remedies of a failed arc-length step by cause, where they differ from a load step's
+ARC_REMEDIES = {
+    "divergence": "a smaller first arc length ([analysis] arc_length) or max_arc_length",
+    "stagnation above the floor": "a smaller max_arc_length; if it persists, a smaller "
+    "min_arc_length",
+    "max iterations": "a smaller max_arc_length ([analysis]), or more iterations",
+    "nan": "a smaller max_arc_length; a NaN also comes from a state outside the model's range "
+    "(a folded element)",
+}
+
+
+def arc_remedy(cause):
+    """The remedy of a failed arc-length trace whose last attempt failed by ``cause``."""
+    return ARC_REMEDIES.get(cause) or remedy(cause)

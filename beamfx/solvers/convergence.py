@@ -59,6 +59,15 @@ REASONS = {
     "DIVERGED_TR_DELTA": "the trust region became too small",
 }
 
+#: the PETSc reason of each outcome of :meth:`ScaledTest.check`
+CODES = {
+    None: "CONVERGED_ITERATING",
+    "nan": "DIVERGED_FNORM_NAN",
+    "residual": "CONVERGED_FNORM_ABS",
+    "relative": "CONVERGED_FNORM_RELATIVE",
+    "floor": "CONVERGED_SNORM_RELATIVE",
+}
+
 #: remedies by cause
 REMEDIES = {
     "divergence": "smaller load steps: [analysis] steps = {steps} (or more)",
@@ -131,12 +140,29 @@ class ScaledTest:
         """Forget the last solve (called before each)."""
         self.records, self.how = [], None
         self.first_energy, self.state_energy, self.floor = 0.0, None, None
+        self.state_norm = None
 
     def __call__(self, snes, it, norms):
         """PETSc's reason after iteration ``it`` (norms: ‖x‖, ‖du‖, ‖F‖); ITERATING to go on."""
         from petsc4py import PETSc
 
-        reason = PETSc.SNES.ConvergedReason
+        F = snes.getFunction()[0]
+        du = snes.getSolutionUpdate() if it > 0 else None
+        how = self.check(it, norms, F, du, snes.getSolution())
+        return getattr(PETSc.SNES.ConvergedReason, CODES[how])
+
+    def check(self, it, norms, F, du, x):
+        """The test after iteration ``it`` of any Newton loop (SNES's, the arc length's):
+        'residual', 'floor' or 'relative' when converged (also set as ``how``), 'nan', or
+        None to go on.
+
+        Args:
+            it: the iteration (0: the residual of the starting state).
+            norms: (‖x‖, ‖du‖, ‖F‖) at this iteration.
+            F: the residual vector at ``x`` (copied for the next energy criterion).
+            du: the last correction (None at ``it`` 0).
+            x: the state (the iterate).
+        """
         xnorm, ynorm, fnorm = norms
         s = self.solver
         record = {"fnorm": fnorm, "step": ynorm, "state": xnorm, "energy": None, "floor": None}
@@ -144,30 +170,29 @@ class ScaledTest:
         scale = max(s.force_scale, s.reactions)
         record["scale"] = scale
         tol = max(s.atol, RESIDUAL_TOL * scale)
-        F = snes.getFunction()[0]
         if it > 0:
-            record["energy"] = abs(snes.getSolutionUpdate().dot(self.F_prev))
+            record["energy"] = abs(du.dot(self.F_prev))
             self.first_energy = max(self.first_energy or 0.0, record["energy"])
         F.copy(self.F_prev)
         if not np.isfinite(fnorm):
-            return reason.DIVERGED_FNORM_NAN
+            return "nan"
         if fnorm <= tol:
             self.how = "residual"
-            return reason.CONVERGED_FNORM_ABS
-        if it == 0 or not self.increment_small(record, snes.getSolution()):
-            return reason.CONVERGED_ITERATING
+            return self.how
+        if it == 0 or not self.increment_small(record, x):
+            return None
         if s.rtol and fnorm <= s.rtol * self.records[0]["fnorm"]:
             self.how = "relative"
-            return reason.CONVERGED_FNORM_RELATIVE
+            return self.how
         if self.floor is None:  # once per solve: the tangent hardly changes at this stage
-            self.floor = self.absolute.floor(s.A, snes.getSolution(), s.sizes)
+            self.floor = self.absolute.floor(s.A, x, s.sizes)
         record["floor"] = self.floor
         # with no load, the reactions are round-off too: nothing to resolve beyond the floor
         unloaded = s.force_scale == 0.0 and scale <= FLOOR_FACTOR * self.floor
         if fnorm <= FLOOR_FACTOR * self.floor and (fnorm <= FLOOR_LIMIT * scale or unloaded):
             self.how = "floor"
-            return reason.CONVERGED_SNORM_RELATIVE
-        return reason.CONVERGED_ITERATING
+            return self.how
+        return None
 
     def linear(self, x, fnorm):
         """The test after one linear solve (``snes_type ksponly``): the residual criterion, or
@@ -182,9 +207,19 @@ class ScaledTest:
             self.how = "floor"
 
     def increment_small(self, record, x):
-        """The increment criteria of the last iteration: ‖du‖ ≤ INCREMENT_TOL·‖x‖ and
+        """The increment criteria of the last iteration: ‖du‖ ≤ INCREMENT_TOL·‖|x| + s‖ and
         |du·F| ≤ ENERGY_TOL·E, E the larger of the solve's largest correction energy and the
-        state's |x·Kx| (K the last tangent)."""
+        state's |x·Kx| (K the last tangent).
+
+        The state is measured with the sizes s of the floor estimate (the reference
+        geometry), as the floor is: a displacement is small or large against the element, not
+        against itself (a nearly unloaded state, or a planar model whose rotation angles
+        start at zero where the 3D model's quaternions have unit norm). Near a singular
+        tangent (a limit or bifurcation point) the correction along the null vector stays at
+        floor/μ, far above 1e-6 of a small displacement, but not of the geometry."""
+        if self.state_norm is None:
+            self.state_norm = self.measure(x)
+        record["state"] = self.state_norm
         if record["step"] > INCREMENT_TOL * record["state"]:
             return False
         if self.state_energy is None:
@@ -192,6 +227,14 @@ class ScaledTest:
             self.state_energy = abs(x.dot(self.Kx))
         record["reference"] = max(self.first_energy, self.state_energy)
         return record["energy"] <= ENERGY_TOL * record["reference"]
+
+    def measure(self, x):
+        """‖|x| + s‖₂ of the state ``x`` (s the solver's sizes; ‖x‖ without). Collective."""
+        sizes = self.solver.sizes
+        if sizes is None:
+            return x.norm()
+        local = np.abs(x.getArray(readonly=True)) + sizes
+        return float(np.sqrt(x.getComm().tompi4py().allreduce(float(local @ local))))
 
     def destroy(self):
         """Free the PETSc objects."""

@@ -106,7 +106,7 @@ class NewtonSolver:
         self.atol = float(self.options.get("snes_atol", 0.0))
         self.rtol = float(self.options.get("snes_rtol", 0.0))
         self.force_scale, self.reactions, self.sizes = 0.0, 0.0, None
-        self._rows = _constrained_rows(bcs, self.b.getLocalSize())
+        self._rows = constrained_rows(bcs, self.b.getLocalSize())
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
@@ -226,7 +226,7 @@ class NewtonSolver:
         self.x.destroy()
 
 
-def _constrained_rows(bcs, n_owned):
+def constrained_rows(bcs, n_owned):
     """Owned local rows of the dofs constrained by ``bcs`` (where the reactions are)."""
     if not bcs:
         return np.empty(0, np.int32)
