@@ -90,5 +90,49 @@ log(
     f"dynamic snap-through between 4000 and 4600 N/m, {4000 / q_limit:.2f}-{4600 / q_limit:.2f} of the static limit"
 )
 
+# ## Without shear and extension flexibility: an antisymmetric bifurcation
+# The shipped `beamfx/scenes/shallow_arch_bifurcation.toml`: the same arch, shear-rigid and
+# inextensible (`[model] shear = false, stretch = false`), at 7500 N/m. The perfect arch only
+# shortens until its tangent has a zero eigenvalue with an antisymmetric mode: the arc-length
+# trace counts the tangent's negative eigenvalues at every point, locates the change (regula
+# falsi on the arc length, inside the bracket the inertia keeps) and, with
+# `branch = "secondary"`, steps along the mode onto the antisymmetric branch, followed until
+# the crown is down twice the rise. Theories: shallow arch (inextensible) 4π²EI/(S²R) =
+# 6667 N/m; deep arch under a pressure that follows the arch (Timoshenko & Gere)
+# (EI/R³)(π²/α² − 1) = 6562.5 N/m. The independent check on the same mesh is a linear
+# buckling analysis about the state at 6500 N/m (`about = "current"`, in the plane).
+
+from beamfx.bench.shallow_arch import scene_data
+from beamfx.bench.shallow_arch_bifurcation import Q_BELOW, Q_BIF, buckling_data, theories
+
+bif = run("bifurcation", scene_data("shallow_arch_bifurcation")).result
+point = next(c for c in bif.critical_points if c["kind"] == "bifurcation")
+q_bif = point["load_factor"] * Q_BIF
+q_bracket = (point["load_factor_bracket"][1] - point["load_factor_bracket"][0]) * Q_BIF
+q_buckling = run("buckling", buckling_data()).result.load_factors[0] * Q_BELOW
+bounds = theories()
+log(f"bifurcation located at {q_bif:.4f} N/m (the inertia brackets it within {q_bracket:.1e})")
+log(f"linear buckling about the state at {Q_BELOW:.0f} N/m: {q_buckling:.4f} N/m")
+log(
+    f"theories: shallow arch {bounds['q_shallow']:.1f} N/m, deep arch under a follower "
+    f"pressure {bounds['q_deep_follower']:.1f} N/m"
+)
+end = bif.path[-1]
+log(
+    f"secondary branch: {len(bif.path)} points, ends at load factor {end['load_factor']:.3f}"
+    f" with the crown down {abs(end['displacement'][2]):.3f}"
+)
+# the located point is the linear buckling load of the same mesh, within the location's bracket
+# (the primary path is a membrane state: no rotation before buckling, so the linearisation is
+# exact up to the solver's digits)
+assert abs(q_bif - q_buckling) <= q_bracket + 1e-8 * q_bif
+# shallow theory neglects the depth: O((rise/span)^2) = (1.522/15.31)^2 ~ 1 %; the dead load
+# has no load stiffness, so it buckles above the follower pressure (which has)
+assert abs(q_bif / bounds["q_shallow"] - 1) < (1.522 / 15.307) ** 2
+assert bounds["q_deep_follower"] < q_bif
+# the trace switched branch there and reached the displacement limit on the secondary branch
+assert point["switched"] and bif.stopped_by == "stop" and end["displacement"][2] <= -3.0
+assert any(p.get("note") == "branch switch" for p in bif.path)
+
 if rank0:
     log(f"results in {OUT}")

@@ -89,7 +89,8 @@ class Result(_Base):
     stopped_by: str = entry("target, stop (displacement limit) or max_steps")
     critical_points: tuple = entry(
         "limit and bifurcation points passed: where the number of negative eigenvalues of the "
-        "tangent changed, the step and load-factor interval, the located load factor"
+        "tangent changed, the step and load-factor interval, the located load factor (and "
+        "the bracket of load factors the inertia puts it in)"
     )
 
     def summary(self) -> dict:
@@ -219,6 +220,7 @@ def critical_points(result, limits):
                 "load_factor": lam,
                 "negative_eigenvalues": [c.negative_before, c.negative_after],
                 "switched": c.switched,
+                "load_factor_bracket": None if c.bracket is None else list(c.bracket),
             }
         )
     return out

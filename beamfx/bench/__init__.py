@@ -23,6 +23,7 @@ def all_cases():
         schwab_meijaard_rotating,
         schwab_meijaard_torque,
         shallow_arch,
+        shallow_arch_bifurcation,
         transient,
     )
 

@@ -75,22 +75,30 @@ def shallow_theory(EI, EA, R, S, terms=201, ds=2e-3, H_end=1.5):
     return H, H / R - c, crown, H2
 
 
-def theory_loads():
+def theory_loads(EA=E * A):
     """The shallow theory's symmetric limit load (and crown deflection there) and its
-    antisymmetric bifurcation load, N/m."""
-    H, q, crown, H2 = shallow_theory(E * I, E * A, R, S)
+    antisymmetric bifurcation load, N/m (``EA``: the axial stiffness; 1e8·E·A for the
+    inextensible arch)."""
+    H, q, crown, H2 = shallow_theory(E * I, EA, R, S)
     top = int(np.argmax(q))
     bif = int(np.argmax(H >= H2))
     return {"q_limit": q[top], "crown_limit": crown[top], "q_bifurcation": q[bif]}
 
 
-def _scene(n, p):
+def scene_data(name, n=None, p=None):
+    """The TOML data of the shipped scene ``name`` (e.g. "shallow_arch_snap"), with ``n``
+    elements of degree ``p`` if given."""
+    text = resources.files("beamfx.scenes").joinpath(f"{name}.toml").read_text()
+    data = tomllib.loads(text)
+    if n is not None:
+        data["beams"][0].update(elements=n, degree=p)
+    return data
+
+
+def _scene(n, p, name="shallow_arch_snap", data=None):
     from ..scene.load import parse_scene
 
-    text = resources.files("beamfx.scenes").joinpath("shallow_arch_snap.toml").read_text()
-    data = tomllib.loads(text)
-    data["beams"][0].update(elements=n, degree=p)
-    return parse_scene(data, "shallow_arch_snap.toml")
+    return parse_scene(data or scene_data(name, n, p), f"{name}.toml")
 
 
 def _snap(n, p):

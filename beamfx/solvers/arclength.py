@@ -649,8 +649,13 @@ class ArcLengthSolver:
         self.seconds["locate"] += time.perf_counter() - t
         if x is not None:
             point = point._replace(load_factor=lam_c, eigenvalue=mu, probes=n)
+            point = point._replace(bracket=self._bracket)
             if log:
-                log(f"  bifurcation located at load factor {lam_c:.8g} ({n} solves)")
+                lo, hi = self._bracket
+                log(
+                    f"  bifurcation located at load factor {lam_c:.8g} ({n} solves; the "
+                    f"inertia changes between {lo:.10g} and {hi:.10g})"
+                )
         if x is None or not switch:
             path.critical.append(point)
             self._restore(end, lam_end)
@@ -696,9 +701,12 @@ class ArcLengthSolver:
             count = self._count()
             mu, _ = smallest_eigenpair(self.A, self._solve, phi)
             last.update(lam=lam, mu=mu)
+            # the nearest probes on either side: the inertia brackets the point between them
+            last["below" if count == point.negative_before else "above"] = lam
             return count, mu
 
         x, n = locate(probe, dl, point.negative_before, self.settings.locate_tol)
+        self._bracket = (last["below"], last["above"])
         # the sign of the mode: its largest measured component positive (same on any ranks)
         a = phi.getArray(readonly=True)[self.norm_dofs]
         top = self.comm.allreduce(float(a.max(initial=-np.inf)), op=MPI.MAX)

@@ -51,6 +51,8 @@ class CriticalPoint(NamedTuple):
         eigenvalue: the eigenvalue of K nearest zero at the located point (Euclidean).
         probes: solves spent locating it.
         switched: the trace left the primary path here along the secondary branch.
+        bracket: (λ, λ) of the nearest probes on either side of the located point: the
+            inertia says the point lies between them (its precision).
     """
 
     kind: str
@@ -62,6 +64,7 @@ class CriticalPoint(NamedTuple):
     eigenvalue: float | None = None
     probes: int = 0
     switched: bool = False
+    bracket: tuple | None = None
 
 
 def classify(before, after, forward_before, forward_after):
