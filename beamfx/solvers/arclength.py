@@ -57,7 +57,7 @@ import numpy as np
 
 from .assembly import assemble_load, assemble_residual, assemble_tangent
 from .bifurcation import CriticalPoint, classify, locate, smallest_eigenpair
-from .convergence import INCREMENT_TOL, ScaledTest, diagnose, remedy
+from .convergence import ScaledTest, diagnose, remedy
 from .forms import compile_form
 from .inertia import InertiaCounter, counts_inertia, negative_pivots, prepare
 from .options import petsc_options
@@ -404,8 +404,10 @@ class ArcLengthSolver:
         x = self.w.vector
         norms = (x.norm(), self.dw_R.norm() if it else 0.0, fnorm)
         how = self.test.check(it, norms, self.R, self.dw_R if it else None, x)
-        if how in ("floor", "relative") and abs(ddlam) > INCREMENT_TOL * abs(lam):
-            how = self.test.how = None
+        if how in ("floor", "relative") and it:  # δλ's share of the correction settled too
+            record = self.test.records[-1]
+            if abs(ddlam) * self.dw_f.norm() > self.test.allowed(record, x):
+                how = self.test.how = None
         self.seconds["test"] += time.perf_counter() - t
         if how == "nan":
             raise self._failed("DIVERGED_FNORM_NAN", "the residual is not finite", [fnorm])

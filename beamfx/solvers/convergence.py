@@ -15,7 +15,9 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
   element length for displacements, so that the terms of the reference geometry count), and
   ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too),
   *and* the increment criteria hold: the last correction is small against the state,
-  ‖du‖ ≤ :data:`INCREMENT_TOL`·‖x‖, and its energy is small, |du·F| ≤ :data:`ENERGY_TOL`·E
+  ‖du‖ ≤ :data:`INCREMENT_TOL`·‖|x| + s‖ (or :data:`SETTLED_TOL`·‖|x| + s‖ once the
+  corrections stagnate: round-off moves the state, Newton no longer does), and its
+  energy is small, |du·F| ≤ :data:`ENERGY_TOL`·E
   with E the larger of the solve's largest correction energy and the state's |x·Kx|;
 * **relative** (only if ``snes_rtol`` is given in ``[solver]``): ‖F‖ ≤ rtol·‖F₀‖ and the
   increment criteria hold.
@@ -33,8 +35,10 @@ FLOOR_FACTOR = 10.0
 #: the floor is accepted only if the residual is also below this fraction of the force scale
 #: (five digits of equilibrium); a floor above it means the state cannot be resolved
 FLOOR_LIMIT = 1e-5
-#: the increment criterion at the floor: ‖du‖ ≤ INCREMENT_TOL·‖x‖
-INCREMENT_TOL = 1e-6
+#: the increment criterion at the floor: ‖du‖ ≤ INCREMENT_TOL·‖|x| + s‖ ...
+INCREMENT_TOL = 1e-10
+#: ... or ‖du‖ ≤ SETTLED_TOL·‖|x| + s‖ once the corrections stagnate (round-off)
+SETTLED_TOL = 1e-6
 #: the energy criterion at the floor (quadratic in the error: INCREMENT_TOL²)
 ENERGY_TOL = 1e-12
 
@@ -111,7 +115,10 @@ class AbsoluteTangent:
 
     def floor(self, A, x, sizes):
         """ε‖ |A| (|x| + sizes) ‖₂ (``sizes``: local owned array or None). Collective."""
-        rows, cols, vals = A.getValuesCSR()
+        # a copy of the tangent: its pattern may have grown (a coupling's entries added)
+        self.B.destroy()
+        self.B = A.duplicate(copy=True)
+        rows, cols, vals = self.B.getValuesCSR()
         self.B.setValuesCSR(rows, cols, np.abs(vals))
         self.B.assemble()
         state = np.abs(x.getArray(readonly=True))
@@ -179,20 +186,26 @@ class ScaledTest:
         if fnorm <= tol:
             self.how = "residual"
             return self.how
-        if it == 0 or not self.increment_small(record, x):
+        if it == 0:
             return None
-        if s.rtol and fnorm <= s.rtol * self.records[0]["fnorm"]:
+        relative = s.rtol and fnorm <= s.rtol * self.records[0]["fnorm"]
+        if relative and self.increment_small(record, x):
             self.how = "relative"
             return self.how
+        # with no load, the reactions are round-off too: nothing to resolve beyond the floor
+        unloaded = s.force_scale == 0.0
+        if fnorm > FLOOR_LIMIT * scale and not unloaded:
+            return None
         if self.floor is None:  # once per solve: the tangent hardly changes at this stage
             self.floor = self.absolute.floor(s.A, x, s.sizes)
         record["floor"] = self.floor
-        # with no load, the reactions are round-off too: nothing to resolve beyond the floor
-        unloaded = s.force_scale == 0.0 and scale <= FLOOR_FACTOR * self.floor
-        if fnorm <= FLOOR_FACTOR * self.floor and (fnorm <= FLOOR_LIMIT * scale or unloaded):
-            self.how = "floor"
-            return self.how
-        return None
+        unloaded = unloaded and scale <= FLOOR_FACTOR * self.floor
+        if fnorm > FLOOR_FACTOR * self.floor or (fnorm > FLOOR_LIMIT * scale and not unloaded):
+            return None
+        if not self.increment_small(record, x):
+            return None
+        self.how = "floor"
+        return self.how
 
     def linear(self, x, fnorm):
         """The test after one linear solve (``snes_type ksponly``): the residual criterion, or
@@ -207,26 +220,33 @@ class ScaledTest:
             self.how = "floor"
 
     def increment_small(self, record, x):
-        """The increment criteria of the last iteration: ‖du‖ ≤ INCREMENT_TOL·‖|x| + s‖ and
+        """The increment criteria of the last iteration: ‖du‖ ≤ :meth:`allowed` and
         |du·F| ≤ ENERGY_TOL·E, E the larger of the solve's largest correction energy and the
-        state's |x·Kx| (K the last tangent).
-
-        The state is measured with the sizes s of the floor estimate (the reference
-        geometry), as the floor is: a displacement is small or large against the element, not
-        against itself (a nearly unloaded state, or a planar model whose rotation angles
-        start at zero where the 3D model's quaternions have unit norm). Near a singular
-        tangent (a limit or bifurcation point) the correction along the null vector stays at
-        floor/μ, far above 1e-6 of a small displacement, but not of the geometry."""
-        if self.state_norm is None:
-            self.state_norm = self.measure(x)
-        record["state"] = self.state_norm
-        if record["step"] > INCREMENT_TOL * record["state"]:
+        state's |x·Kx| (K the last tangent)."""
+        if record["step"] > self.allowed(record, x):
             return False
         if self.state_energy is None:
             self.solver.A.mult(x, self.Kx)
             self.state_energy = abs(x.dot(self.Kx))
         record["reference"] = max(self.first_energy, self.state_energy)
         return record["energy"] <= ENERGY_TOL * record["reference"]
+
+    def allowed(self, record, x):
+        """The largest correction that counts as settled: INCREMENT_TOL·‖|x| + s‖, or, once
+        the corrections stagnate (the last three within a factor 10: round-off moves the
+        state, Newton no longer does), SETTLED_TOL·‖|x| + s‖. A penalty (EA, GA ≫ EI/L²)
+        makes Newton converge slowly in the soft (bending) unknowns while the residual sits
+        at the stiff terms' floor: a correction of 1e-6 of the state there still leaves an
+        error of 1e-6, and the next ones shrink. Near a singular tangent (a limit or
+        bifurcation point) round-off moves the state along the null vector by floor/μ at
+        every iteration: the corrections stagnate. The state is measured with the sizes s
+        of the floor estimate (the reference geometry), as the floor is."""
+        if self.state_norm is None:
+            self.state_norm = self.measure(x)
+        record["state"] = self.state_norm
+        steps = [r["step"] for r in self.records[1:]][-3:]
+        settled = len(steps) == 3 and max(steps) <= 10 * min(steps)
+        return (SETTLED_TOL if settled else INCREMENT_TOL) * self.state_norm
 
     def measure(self, x):
         """‖|x| + s‖₂ of the state ``x`` (s the solver's sizes; ‖x‖ without). Collective."""
@@ -279,7 +299,8 @@ def diagnose(reason, records, floor):
         r = records[-1]
         step = r["step"] / r["state"] if r["state"] else np.inf
         return "stagnation at the floor", (
-            f"{numbers}; the last increment |du|/|x| = {step:.2e} (criterion {INCREMENT_TOL:g})"
+            f"{numbers}; the last increment |du|/|x| = {step:.2e} (criterion {INCREMENT_TOL:g}, "
+            f"or {SETTLED_TOL:g} once the increments stagnate)"
         )
     if _stagnates(f):
         return "stagnation above the floor", numbers
