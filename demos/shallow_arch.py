@@ -123,9 +123,10 @@ log(
     f" with the crown down {abs(end['displacement'][2]):.3f}"
 )
 # the located point is the linear buckling load of the same mesh, within the location's bracket
-# (the primary path is a membrane state: no rotation before buckling, so the linearisation is
-# exact up to the solver's digits)
-assert abs(q_bif - q_buckling) <= q_bracket + 1e-8 * q_bif
+# and the linear buckling's own digits: the primary path is a membrane state (no rotation
+# before buckling), so the linearisation is exact but for round-off, and about states at 6000,
+# 6500 and 6600 N/m it gives the same load to 6e-8 (the penalty's round-off in the state)
+assert abs(q_bif - q_buckling) <= q_bracket + 1e-7 * q_bif
 # shallow theory neglects the depth: O((rise/span)^2) = (1.522/15.31)^2 ~ 1 %; the dead load
 # has no load stiffness, so it buckles above the follower pressure (which has)
 assert abs(q_bif / bounds["q_shallow"] - 1) < (1.522 / 15.307) ** 2
