@@ -22,9 +22,12 @@ from mpi4py import MPI
 
 from ..geometry import BeamSpec, build_mesh
 from ..geometry.frames import default_reference
+from ..physics import coupled, energy
+from ..physics.coupled import as_matrix6
 from ..physics.kinematics import section_frame, tangent
 from ..spec import resolve_point
 from .checks import joint_breaks
+from .section_fields import SectionMatrices, is_coupled, matrix_fields
 
 
 def cell_field(mesh, degree, values):
@@ -143,7 +146,19 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
     p = max(b.degree for b in spec.beams)
     named, mesh = _beam_mesh(spec, comm, p, extra_points)
     m, cb = mesh.mesh, mesh.cell_beam
-    stiffness, inertia, raw_max = _section_fields(spec, mesh, comm)
+    matrices = None
+    if is_coupled(spec):
+        *fields, C6, M6 = matrix_fields(
+            spec,
+            mesh,
+            comm,
+            lambda X: cell_arc_lengths(spec, mesh, X),
+            lambda q, values: cell_field(m, q, values),
+        )
+        stiffness, inertia, raw_max = fields
+        matrices = SectionMatrices(as_matrix6(C6), as_matrix6(M6))
+    else:
+        stiffness, inertia, raw_max = _section_fields(spec, mesh, comm)
     ref = default_reference(_cell_tangents(mesh))
     for i, b in enumerate(spec.beams):
         if b.orientation is not None:
@@ -170,6 +185,7 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         C_M=ufl.diag(ufl.as_vector([C[3], C[4], C[5]])),
         dx_shear=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p - 1}),
         dx=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p}),
+        matrices=matrices,
     )
 
 
@@ -198,6 +214,26 @@ class Discretisation:
     C_M: object  #: UFL diag(GJ, EI_y, EI_z)
     dx_shear: object  #: measure of the shear and axial energy (degree 2p − 1)
     dx: object  #: measure of everything else (degree 2p)
+    matrices: object = None  #: :class:`SectionMatrices`, or None: every section is diagonal
+
+    def strain_energy(self, Gamma, K, scale=None):
+        """The strain energy of the sections (times ``scale``, e.g. a damping time, if given):
+        :func:`~beamfx.physics.energy.strain_energy` with C_N, C_M for diagonal sections, the
+        coupled form :func:`~beamfx.physics.coupled.strain_energy` with a matrix section."""
+        if self.matrices is None:
+            if scale is None:
+                return energy.strain_energy(Gamma, K, self.C_N, self.C_M, self.dx_shear, self.dx)
+            return energy.strain_rate_dissipation(
+                Gamma, K, self.C_N, self.C_M, scale, self.dx_shear, self.dx
+            )
+        C = self.matrices.C if scale is None else scale * self.matrices.C
+        return coupled.strain_energy(Gamma, K, C, self.dx_shear, self.dx)
+
+    def resultants(self, Gamma, K):
+        """Section force and moment (N, M) of the strains (Γ, K), section axes."""
+        if self.matrices is None:
+            return self.C_N * Gamma, self.C_M * K
+        return coupled.resultants(Gamma, K, self.matrices.C)
 
     def cell_arc_lengths(self, X):
         """Arc length of the reference points ``X`` (in [0, 1]) of each local cell."""
