@@ -18,8 +18,8 @@ integrated here by Gauss–Legendre quadrature exact for the polynomial integran
 import numpy as np
 import pytest
 
-from beamfx.analyses.model import BeamModel
 from beamfx.analyses.modal import solve_modes
+from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
 from beamfx.geometry import Line
 from beamfx.geometry.frames import section_axes_at
