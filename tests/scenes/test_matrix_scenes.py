@@ -116,3 +116,21 @@ def test_a_matrix_section_from_a_rectangle_gives_the_rectangles_answers(
             x,
             y,
         )
+
+
+def test_the_shipped_coupled_cantilever_scene_gives_the_flexibility_integral(tmp_path):
+    """beamfx/scenes/coupled_cantilever.toml as a user runs it (4 × P2): the tip is exact."""
+    from importlib import resources
+
+    from beamfx.bench.coupled_cantilever import reference
+
+    path = resources.files("beamfx.scenes").joinpath("coupled_cantilever.toml")
+    results = run_scene(str(path), tmp_path / "out", log=lambda *a, **k: None)
+    tip = results["probes"]["tip"]
+    ref = reference()
+    got = {
+        **dict(zip(["ux", "uy", "uz"], tip["displacement"])),
+        **dict(zip(["rx", "ry", "rz"], tip["rotation_vector"])),
+    }
+    for k, v in ref.items():
+        assert abs(got[k] - v) < 1e-11 * abs(v), (k, got[k], v)
