@@ -9,7 +9,7 @@ continuum beam (:mod:`beamfx.continuum.solve`) takes its mesh, end points and me
 
 Section data per cell: the stiffnesses (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertias
 (ρA, ρI_1, ρI_2, ρI_3) are DG_p fields where a section varies along a beam and DG0 otherwise;
-the reference vector and twist are DG0. The measures integrate the shear and axial energy
+the reference vector is DG0, the twist DG0 unless it varies along a beam (then DG_p). The measures integrate the shear and axial energy
 with p Gauss points (``dx_shear``, exact to degree 2p − 1: the locking remedy) and the rest
 with p + 1 (``dx``, exact to 2p).
 """
@@ -27,7 +27,7 @@ from ..physics.coupled import as_matrix6
 from ..physics.kinematics import section_frame, tangent
 from ..spec import resolve_point
 from .checks import joint_breaks
-from .section_fields import SectionMatrices, is_coupled, matrix_fields
+from .section_fields import SectionMatrices, dg_points, is_coupled, matrix_fields
 
 
 def cell_field(mesh, degree, values):
@@ -108,6 +108,22 @@ def _section_fields(spec, mesh, comm):
     return cell_field(m, q, stiff), cell_field(m, q, mass), raw_max
 
 
+def _twist_field(spec, mesh):
+    """The twist (radians): DG0 if every beam's is a number, else DG_p at the interpolation
+    points (a twist varying along a beam, sampled pointwise like the sections)."""
+    twists = [b.twist_deg for b in spec.beams]
+    cb, m = mesh.cell_beam, mesh.mesh
+    if not any(callable(t) for t in twists):
+        return cell_function(m, np.deg2rad([twists[b] for b in cb]))
+    q = mesh.degree
+    S = cell_arc_lengths(spec, mesh, dg_points(q))
+    values = np.zeros_like(S)
+    for i, t in enumerate(twists):
+        sel = cb == i
+        values[sel] = np.asarray(t(S[sel]), float) if callable(t) else t
+    return cell_field(m, q, np.deg2rad(values))
+
+
 def _cell_tangents(mesh):
     """Unit chord of each local cell, from its vertex 0 to its vertex 1."""
     m = mesh.mesh
@@ -164,7 +180,7 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         if b.orientation is not None:
             ref[cb == i] = b.orientation
     reference = cell_function(m, ref)
-    twist = cell_function(m, np.deg2rad([spec.beams[b].twist_deg for b in cb]))
+    twist = _twist_field(spec, mesh)
     t0 = tangent(m)
     C = stiffness
     return Discretisation(
@@ -207,7 +223,7 @@ class Discretisation:
     inertia: object  #: DG Function (ρA, ρI_1, ρI_2, ρI_3)
     stiffness_scale: float  #: largest EA, GA_y or GA_z before the limits (all ranks)
     reference: object  #: DG0 Function: orientation vector of each cell (global axes)
-    twist: object  #: DG0 Function: twist of each cell (radians)
+    twist: object  #: DG0 Function: twist of each cell (radians); DG_p if it varies along a beam
     t0: object  #: UFL unit tangent of the reference centre line
     Lam0: object  #: UFL reference section frame Λ0 (columns t0, e2, e3)
     C_N: object  #: UFL diag(EA, GA_y, GA_z)

@@ -180,7 +180,7 @@ def _beams(top, mat, base, limits):
                 t.get("elements", int, 8, positive=True),
                 t.get("degree", int, 2, choices=(1, 2, 3, 4)),
                 t.get("orientation", "vec3", None),
-                t.get("twist_deg", float, 0.0),
+                scene_sections.twist(t, curve.length),
             )
         )
         t.done()

@@ -125,3 +125,16 @@ def with_offsets(t, section, given, length):
     )  # fmt: skip
     M = ms.offset_mass(s.rho_A, s.rho_I, given.get("mass_centre", (0.0, 0.0)))
     return ms.MatrixSection(C, M, (0.0,), length)
+
+
+def twist(t, length):
+    """``twist_deg`` of a beam table ``t``: a number (degrees), an expression of the arc length
+    ``s`` (and ``L``) or a table ``{ s = [...], values = [...] }`` (piecewise linear in s)."""
+    from .load import _along
+
+    value = _along(t, "twist_deg", length, default=0.0, positive=False)
+    if callable(value):
+        samples = value(np.linspace(0.0, length, 201))
+        if not np.all(np.isfinite(samples)):
+            t.fail("twist_deg", "must be finite along the whole beam")
+    return value

@@ -215,3 +215,59 @@ def test_offset_centres_spin_like_the_translated_beam():
         freqs.append(solve_rotating_modes(frame, 6).hz)
         frame.destroy()
     assert np.allclose(freqs[0], freqs[1], rtol=1e-7), freqs
+
+
+def _twisted_error(elements, degree, section_C, total_deg=90.0):
+    """Relative tip error of the linear cantilever (length 2, along x) whose twist grows
+    linearly from 0 to ``total_deg``, against the flexibility integral with the section
+    matrix turned with the frame, C_g(s) = Q C Qᵀ, Q = diag(Λ0(s), Λ0(s))."""
+    L = 2.0
+
+    def twist(s):
+        return total_deg * np.asarray(s, float) / L
+
+    def Lam(s):
+        c, sn = np.cos(np.deg2rad(twist(s))), np.sin(np.deg2rad(twist(s)))
+        return np.array([[1.0, 0, 0], [0, c, -sn], [0, sn, c]])
+
+    def C_global(s):
+        Q = np.kron(np.eye(2), Lam(s))
+        return Q @ section_C @ Q.T
+
+    u_ref, th_ref = flexibility_tip(C_global, L, F_TIP, M_TIP, Q)
+    beam = Beam(
+        "b",
+        Line((0, 0, 0), (L, 0, 0)),
+        MatrixSection(section_C, np.zeros((6, 6))),
+        elements,
+        degree,
+        (0.0, 0.0, 1.0),
+        twist,
+    )
+    spec = Model(
+        beams=(beam,),
+        supports=(Support("b:start", CLAMP),),
+        point_loads=(PointLoad("b:end", tuple(F_TIP), tuple(M_TIP)),),
+        distributed_loads=(DistributedLoad("b", tuple(Q)),),
+        kinematics=LINEAR,
+    )
+    model = BeamModel(spec, extra_points=["b:end"])
+    solve_static(model, steps=1)
+    tip = evaluate_points(model, ["b:end"])["b:end"]
+    u, th = np.asarray(tip["displacement"]), np.asarray(tip["rotation_vector"])
+    return max(
+        np.abs(u - u_ref).max() / np.abs(u_ref).max(),
+        np.abs(th - th_ref).max() / np.abs(th_ref).max(),
+    )
+
+
+def test_span_varying_twist_converges_to_the_twisted_flexibility_integral():
+    """twist_deg as a function of s (0 to 90° along the beam) on a coupled section: the frame
+    turns pointwise, and the tip converges at h^2p to the integral of the turned compliance
+    (measured 4.66e-3, 4.17e-4, 2.91e-5 with P2 and 7.08e-5, 1.54e-6, 2.67e-8 with P3 on 4, 8,
+    16 elements)."""
+    C = coupled_stiffness(seed=8)
+    for p, order, bound in ((2, 4.0, 1e-4), (3, 6.0, 1e-7)):
+        e = [_twisted_error(n, p, C) for n in (4, 8, 16)]
+        rates = np.log2(np.array(e[:-1]) / e[1:])
+        assert rates[-1] > order - 0.5 and e[-1] < bound, (p, e, rates)

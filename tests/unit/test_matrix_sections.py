@@ -164,3 +164,38 @@ def test_bad_matrix_sections_name_the_file_key_and_station(section, message):
     with pytest.raises(SceneError, match="blade.toml: beams\\[0\\].section") as e:
         _parse(text.replace("{{", "{").replace("}}", "}"))
     assert __import__("re").search(message, str(e.value)), str(e.value)
+
+
+TWIST = """
+[[beams]]
+name = "b"
+curve = {{ shape = "line", start = [0, 0, 0], end = [4, 0, 0] }}
+section = {{ type = "general", EA = 1, GA_y = 1, GA_z = 1, GJ = 1, EI_y = 1, EI_z = 1 }}
+twist_deg = {twist}
+[[supports]]
+at = "b:start"
+fix = "all"
+"""
+
+
+@pytest.mark.parametrize(
+    "twist, at_1",
+    [("13.5", 13.5), ('"10 * s / L"', 2.5), ("{ s = [0, 2, 4], values = [0, 20, 0] }", 10.0)],
+)
+def test_twist_deg_is_a_number_an_expression_or_a_table_of_s(twist, at_1):
+    import tomllib
+
+    from beamfx.geometry.frames import section_axes_at
+
+    beam = parse_scene(tomllib.loads(TWIST.format(twist=twist)), "blade.toml").model.beams[0]
+    value = beam.twist_deg(np.array([1.0]))[0] if callable(beam.twist_deg) else beam.twist_deg
+    assert np.isclose(value, at_1)
+    frame = section_axes_at(beam.curve, 1.0, beam.orientation, beam.twist_deg)
+    assert np.isclose(np.degrees(np.arctan2(frame[2, 1], frame[1, 1])), at_1)
+
+
+def test_a_bad_twist_expression_names_the_key():
+    import tomllib
+
+    with pytest.raises(SceneError, match="beams\\[0\\].twist_deg: .*unknown name 'x'"):
+        parse_scene(tomllib.loads(TWIST.format(twist='"x * 2"')), "blade.toml")
