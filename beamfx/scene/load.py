@@ -180,7 +180,11 @@ def _beams(top, mat, base, limits):
                 t.get("elements", int, 8, positive=True),
                 t.get("degree", int, 2, choices=(1, 2, 3, 4)),
                 t.get("orientation", "vec3", None),
-                scene_sections.twist(t, curve.length),
+                scene_sections.checked_twist(
+                    t,
+                    _along(t, "twist_deg", curve.length, default=0.0, positive=False),
+                    curve.length,
+                ),
             )
         )
         t.done()

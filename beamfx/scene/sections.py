@@ -127,12 +127,10 @@ def with_offsets(t, section, given, length):
     return ms.MatrixSection(C, M, (0.0,), length)
 
 
-def twist(t, length):
-    """``twist_deg`` of a beam table ``t``: a number (degrees), an expression of the arc length
-    ``s`` (and ``L``) or a table ``{ s = [...], values = [...] }`` (piecewise linear in s)."""
-    from .load import _along
-
-    value = _along(t, "twist_deg", length, default=0.0, positive=False)
+def checked_twist(t, value, length):
+    """``twist_deg`` as read (a number, or a function of the arc length from an expression of
+    ``s`` and ``L`` or a table ``{ s = [...], values = [...] }``), checked finite along the
+    beam."""
     if callable(value):
         samples = value(np.linspace(0.0, length, 201))
         if not np.all(np.isfinite(samples)):
