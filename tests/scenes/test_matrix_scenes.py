@@ -134,3 +134,53 @@ def test_the_shipped_coupled_cantilever_scene_gives_the_flexibility_integral(tmp
     }
     for k, v in ref.items():
         assert abs(got[k] - v) < 1e-11 * abs(v), (k, got[k], v)
+
+
+HUB = """
+[material]
+E = 70e9
+rho = 2700
+
+[[beams]]
+name = "blade"
+curve = {{ shape = "line", start = [0, 0, 0], end = [1, 0, 0] }}
+section = {{ type = "rectangle", h = 0.02, w = 0.05 }}
+elements = 6
+degree = 3
+{stub}
+[[supports]]
+at = "{clamp}"
+fix = "all"
+
+[analysis]
+type = "rotating"
+axis = [0, 0, 1]
+speeds_rad_s = [0, 60]
+modes = 4
+{hub}
+[output]
+dir = "{out}"
+formats = ["vtu"]
+"""
+
+
+def test_a_hub_off_the_beam_is_a_point_anywhere(tmp_path, scene_file):
+    """hub = [x, y, z] off every beam: the blade clamped 1.5 m from the axis spins faster in
+    flap than with the hub at its root, and translating blade and hub together changes
+    nothing (round-off)."""
+    runs = {}
+    for name, x0, hub in (
+        ("root", 0.0, ""),
+        ("off", 0.0, "hub = [-1.5, 0, 0]"),
+        ("moved", 1.5, "hub = [0, 0, 0]"),
+    ):
+        text = HUB.format(stub="", clamp="blade:start", hub=hub, out=tmp_path / name)
+        text = text.replace(
+            "start = [0, 0, 0], end = [1, 0, 0]", f"start = [{x0}, 0, 0], end = [{x0 + 1}, 0, 0]"
+        )
+        runs[name] = run_scene(scene_file(text, f"{name}.toml"), log=lambda *x, **k: None)
+    f = {k: np.array(r["frequencies_hz"]) for k, r in runs.items()}
+    assert runs["off"]["hub"] == {"at": None, "position": [-1.5, 0.0, 0.0]}
+    assert np.allclose(f["off"][0], f["root"][0], rtol=1e-12)  # at rest the hub plays no part
+    assert f["off"][1, 0] > 1.2 * f["root"][1, 0] > 1.2 * f["root"][0, 0]
+    assert np.allclose(f["off"], f["moved"], rtol=1e-9), (f["off"], f["moved"])

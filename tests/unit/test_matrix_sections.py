@@ -199,3 +199,15 @@ def test_a_bad_twist_expression_names_the_key():
 
     with pytest.raises(SceneError, match="beams\\[0\\].twist_deg: .*unknown name 'x'"):
         parse_scene(tomllib.loads(TWIST.format(twist='"x * 2"')), "blade.toml")
+
+
+def test_a_bad_hub_names_the_key():
+    import tomllib
+
+    text = (
+        TWIST.format(twist="0") + '[analysis]\ntype = "rotating"\nspeed_rad_s = 1\nhub = [1, 2]\n'
+    )
+    with pytest.raises(SceneError, match="analysis.hub: expected a named point or \\[x, y, z\\]"):
+        parse_scene(tomllib.loads(text), "blade.toml")
+    text = text.replace("hub = [1, 2]", "hub = [-1.5, 0, 0]")
+    assert parse_scene(tomllib.loads(text), "blade.toml").settings.hub == (-1.5, 0.0, 0.0)
