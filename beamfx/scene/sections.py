@@ -8,6 +8,7 @@ matrix section (:mod:`beamfx.physics.matrix_sections`).
 """
 
 from numbers import Real
+from pathlib import Path
 
 import numpy as np
 
@@ -67,7 +68,7 @@ def _stations(t):
     return tuple(float(v) for v in x)
 
 
-def _checked(t, key, matrices, stations, check):
+def _checked(t, key, matrices, stations, check, what=""):
     for k, A in enumerate(matrices):
         try:
             check(A)
@@ -75,7 +76,7 @@ def _checked(t, key, matrices, stations, check):
             where = (
                 f"station {k + 1} (s/L = {stations[k]:g})" if len(stations) > 1 else "the matrix"
             )
-            t.fail(key, f"{where} {e}")
+            t.fail(key, f"{what}{where} {e}")
         matrices[k] = 0.5 * (A + A.T)
     return matrices
 
@@ -136,3 +137,25 @@ def checked_twist(t, value, length):
         if not np.all(np.isfinite(samples)):
             t.fail("twist_deg", "must be finite along the whole beam")
     return value
+
+
+def beamdyn_section(t, length, base):
+    """The matrix section of a ``type = "beamdyn"`` table: ``file``, a BeamDyn blade (or
+    primary) file, relative to the scene's folder (:mod:`beamfx.scene.beamdyn`)."""
+    from .beamdyn import read_blade
+
+    path = Path(base) / t.get("file", str)
+    t.done()
+    try:
+        eta, K, M = read_blade(path)
+    except ValueError as e:
+        t.fail("file", str(e))
+    what = f"{path}: "
+    if len(eta) < 2 or np.any(np.diff(eta) <= 0) or eta[0] != 0.0 or eta[-1] != 1.0:
+        t.fail("file", f"{what}the stations must increase from 0 to 1, got {list(eta)}")
+    stations = tuple(float(x) for x in eta)
+    C = np.array([ms.from_beamdyn(k) for k in K])
+    Mb = np.array([ms.from_beamdyn(m) for m in M])
+    C = _checked(t, "file", C, stations, ms.check_stiffness, what + "stiffness at ")
+    Mb = _checked(t, "file", Mb, stations, ms.check_mass, what + "mass at ")
+    return ms.MatrixSection(C, Mb, stations, length)
