@@ -128,17 +128,6 @@ def with_offsets(t, section, given, length):
     return ms.MatrixSection(C, M, (0.0,), length)
 
 
-def checked_twist(t, value, length):
-    """``twist_deg`` as read (a number, or a function of the arc length from an expression of
-    ``s`` and ``L`` or a table ``{ s = [...], values = [...] }``), checked finite along the
-    beam."""
-    if callable(value):
-        samples = value(np.linspace(0.0, length, 201))
-        if not np.all(np.isfinite(samples)):
-            t.fail("twist_deg", "must be finite along the whole beam")
-    return value
-
-
 def beamdyn_section(t, length, base):
     """The matrix section of a ``type = "beamdyn"`` table: ``file``, a BeamDyn blade (or
     primary) file, relative to the scene's folder (:mod:`beamfx.scene.beamdyn`)."""
@@ -159,3 +148,35 @@ def beamdyn_section(t, length, base):
     C = _checked(t, "file", C, stations, ms.check_stiffness, what + "stiffness at ")
     Mb = _checked(t, "file", Mb, stations, ms.check_mass, what + "mass at ")
     return ms.MatrixSection(C, Mb, stations, length)
+
+
+def read_twist(t, length):
+    """``twist_deg`` of a beam table ``t``: a number (degrees), an expression of the arc length
+    ``s`` (and ``L``) or a table ``{ s = [...], values = [...] }`` (piecewise linear in s),
+    finite along the beam (negative values allowed)."""
+    from .expr import compile_expression, table_function
+    from .table import MAX_MAGNITUDE, Table
+
+    raw = t.data.get("twist_deg", 0.0)
+    if not isinstance(raw, (str, dict)):
+        value = t.get("twist_deg", float, 0.0)
+        if not abs(value) <= MAX_MAGNITUDE:
+            t.fail("twist_deg", f"= {value:g}: must be a finite number")
+        return value
+    t.used.add("twist_deg")
+    try:
+        if isinstance(raw, str):
+            f = compile_expression(raw, "s", {"L": length})
+        else:
+            sub = Table(raw, t.path + ".twist_deg", t.file)
+            f = table_function(sub.get("s", list), sub.get("values", list))
+            sub.done()
+        samples = f(np.linspace(0.0, length, 201))
+    except (ValueError, TypeError, ZeroDivisionError, FloatingPointError, OverflowError) as e:
+        t.fail(
+            "twist_deg",
+            f"{e} (write a number, an expression of s and L, or {{ s = [...], values = [...] }})",
+        )
+    if not np.all(np.abs(samples) <= MAX_MAGNITUDE):
+        t.fail("twist_deg", "must be finite along the whole beam")
+    return f
