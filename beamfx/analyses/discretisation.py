@@ -142,6 +142,8 @@ def _beam_mesh(spec, comm, degree, extra_points):
         breaks[b].append(s)
     for b, s in joint_breaks(spec):
         breaks[b].append(s)
+    for i, b in enumerate(spec.beams):  # matrix sections that ask for vertices at stations
+        breaks[i].extend(getattr(b.section, "station_breaks", list)())
     specs = [
         BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i])) for i, b in enumerate(spec.beams)
     ]

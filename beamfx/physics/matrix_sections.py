@@ -127,12 +127,22 @@ class MatrixSection:
     matrix each in ``stiffness`` and ``mass`` (n, 6, 6); between stations the matrices are
     interpolated linearly, entry by entry (a convex combination of positive definite matrices
     is positive definite, so the interpolant is too). One station: a prismatic beam.
+    ``vertices_at_stations``: the mesh gets a vertex at each inner station, so that the
+    degree-p section fields hold the piecewise linear table exactly.
     """
 
     stiffness: np.ndarray
     mass: np.ndarray
     stations: tuple = (0.0,)
     length: float = 1.0
+    vertices_at_stations: bool = False
+
+    def station_breaks(self):
+        """Arc lengths of the inner stations where the mesh needs vertices (none unless
+        ``vertices_at_stations``)."""
+        if not self.vertices_at_stations:
+            return []
+        return [x * self.length for x in self.stations[1:-1]]
 
     def __post_init__(self):
         for name in ("stiffness", "mass"):

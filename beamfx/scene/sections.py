@@ -91,8 +91,9 @@ def matrix_section(t, length):
         t, "stiffness", _matrices(t, "stiffness", n, convention), stations, ms.check_stiffness
     )
     M = _checked(t, "mass", _matrices(t, "mass", n, convention, False), stations, ms.check_mass)
+    vertices = t.get("vertices_at_stations", bool, False)
     t.done()
-    return ms.MatrixSection(C, M, stations, length)
+    return ms.MatrixSection(C, M, stations, length, vertices)
 
 
 def _pair(t, key):
@@ -134,6 +135,7 @@ def beamdyn_section(t, length, base):
     from .beamdyn import read_blade
 
     path = Path(base) / t.get("file", str)
+    vertices = t.get("vertices_at_stations", bool, False)
     t.done()
     try:
         eta, K, M = read_blade(path)
@@ -147,7 +149,7 @@ def beamdyn_section(t, length, base):
     Mb = np.array([ms.from_beamdyn(m) for m in M])
     C = _checked(t, "file", C, stations, ms.check_stiffness, what + "stiffness at ")
     Mb = _checked(t, "file", Mb, stations, ms.check_mass, what + "mass at ")
-    return ms.MatrixSection(C, Mb, stations, length)
+    return ms.MatrixSection(C, Mb, stations, length, vertices)
 
 
 def read_twist(t, length):
