@@ -15,7 +15,9 @@ APT_PKGS=(
   python3-mpi4py openmpi-bin python3-venv python3-dev build-essential git make
   paraview python3-paraview xvfb xauth  # pvpython; Debian's ParaView renders through X only
 )
-PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib imageio ruff)
+# openfast-io reads BeamDyn files (section type "beamdyn"); 4.2.1 is the last that reads the
+# BeamDyn v1.00 blade files of meshes/nrel5mw (5.0.0 expects a modal-damping block)
+PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib imageio ruff openfast-io)
 
 log() { printf '[install] %s\n' "$*"; }
 

@@ -36,7 +36,7 @@ from typing import NamedTuple
 import numpy as np
 import ufl
 
-from ..physics import energy
+from ..physics import coupled, energy
 from ..physics.kinematics import strains
 from ..solvers.eigen import solve_eigen
 from ..solvers.forms import compile_form
@@ -127,14 +127,17 @@ def penalty_tangent(model):
 
 def stress_stiffness_ufl(model, w_star, dw):
     """K_σ (UFL): second variation at ``model.w`` of ∫ Ṅ·Γ(w) + Ṁ·K(w) ds, with the section
-    force and moment rates Ṅ = C_N Γ̇, Ṁ = C_M K̇ at ``w_star`` in the path direction ``dw``
+    force and moment rates Ṅ = C_N Γ̇, Ṁ = C_M K̇ (C Γ̇ for a matrix section) at ``w_star`` in the path direction ``dw``
     (both Functions, held fixed)."""
     kin, d = model.kin, model.discretisation
     G_star, K_star = strains(kin, *ufl.split(w_star), d.t0, d.Lam0)
-    N = d.C_N * ufl.derivative(G_star, w_star, dw)
-    M = d.C_M * ufl.derivative(K_star, w_star, dw)
+    G_dot, K_dot = ufl.derivative(G_star, w_star, dw), ufl.derivative(K_star, w_star, dw)
     Gamma, K = strains(kin, *ufl.split(model.w), d.t0, d.Lam0)
-    Pi = ufl.dot(N, Gamma) * d.dx_shear + ufl.dot(M, K) * d.dx
+    if d.matrices is None:
+        N, M = d.C_N * G_dot, d.C_M * K_dot
+        Pi = ufl.dot(N, Gamma) * d.dx_shear + ufl.dot(M, K) * d.dx
+    else:  # the same split of the coupled energy as the model's (physics/coupled.py)
+        Pi = coupled.strain_bilinear(G_dot, K_dot, Gamma, K, d.matrices.C, d.dx_shear, d.dx)
     v, dw_ = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
     return ufl.derivative(ufl.derivative(Pi, model.w, v), model.w, dw_)
 

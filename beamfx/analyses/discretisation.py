@@ -9,7 +9,7 @@ continuum beam (:mod:`beamfx.continuum.solve`) takes its mesh, end points and me
 
 Section data per cell: the stiffnesses (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertias
 (ρA, ρI_1, ρI_2, ρI_3) are DG_p fields where a section varies along a beam and DG0 otherwise;
-the reference vector and twist are DG0. The measures integrate the shear and axial energy
+the reference vector is DG0, the twist DG0 unless it varies along a beam (then DG_p). The measures integrate the shear and axial energy
 with p Gauss points (``dx_shear``, exact to degree 2p − 1: the locking remedy) and the rest
 with p + 1 (``dx``, exact to 2p).
 """
@@ -22,9 +22,12 @@ from mpi4py import MPI
 
 from ..geometry import BeamSpec, build_mesh
 from ..geometry.frames import default_reference
+from ..physics import coupled, energy
+from ..physics.coupled import as_matrix6
 from ..physics.kinematics import section_frame, tangent
 from ..spec import resolve_point
 from .checks import joint_breaks
+from .section_fields import SectionMatrices, dg_points, is_coupled, matrix_fields
 
 
 def cell_field(mesh, degree, values):
@@ -105,6 +108,22 @@ def _section_fields(spec, mesh, comm):
     return cell_field(m, q, stiff), cell_field(m, q, mass), raw_max
 
 
+def _twist_field(spec, mesh):
+    """The twist (radians): DG0 if every beam's is a number, else DG_p at the interpolation
+    points (a twist varying along a beam, sampled pointwise like the sections)."""
+    twists = [b.twist_deg for b in spec.beams]
+    cb, m = mesh.cell_beam, mesh.mesh
+    if not any(callable(t) for t in twists):
+        return cell_function(m, np.deg2rad([twists[b] for b in cb]))
+    q = mesh.degree
+    S = cell_arc_lengths(spec, mesh, dg_points(q))
+    values = np.zeros_like(S)
+    for i, t in enumerate(twists):
+        sel = cb == i
+        values[sel] = np.asarray(t(S[sel]), float) if callable(t) else t
+    return cell_field(m, q, np.deg2rad(values))
+
+
 def _cell_tangents(mesh):
     """Unit chord of each local cell, from its vertex 0 to its vertex 1."""
     m = mesh.mesh
@@ -123,6 +142,8 @@ def _beam_mesh(spec, comm, degree, extra_points):
         breaks[b].append(s)
     for b, s in joint_breaks(spec):
         breaks[b].append(s)
+    for i, b in enumerate(spec.beams):  # matrix sections that ask for vertices at stations
+        breaks[i].extend(getattr(b.section, "station_breaks", list)())
     specs = [
         BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i])) for i, b in enumerate(spec.beams)
     ]
@@ -143,13 +164,25 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
     p = max(b.degree for b in spec.beams)
     named, mesh = _beam_mesh(spec, comm, p, extra_points)
     m, cb = mesh.mesh, mesh.cell_beam
-    stiffness, inertia, raw_max = _section_fields(spec, mesh, comm)
+    matrices = None
+    if is_coupled(spec):
+        *fields, C6, M6 = matrix_fields(
+            spec,
+            mesh,
+            comm,
+            lambda X: cell_arc_lengths(spec, mesh, X),
+            lambda q, values: cell_field(m, q, values),
+        )
+        stiffness, inertia, raw_max = fields
+        matrices = SectionMatrices(as_matrix6(C6), as_matrix6(M6))
+    else:
+        stiffness, inertia, raw_max = _section_fields(spec, mesh, comm)
     ref = default_reference(_cell_tangents(mesh))
     for i, b in enumerate(spec.beams):
         if b.orientation is not None:
             ref[cb == i] = b.orientation
     reference = cell_function(m, ref)
-    twist = cell_function(m, np.deg2rad([spec.beams[b].twist_deg for b in cb]))
+    twist = _twist_field(spec, mesh)
     t0 = tangent(m)
     C = stiffness
     return Discretisation(
@@ -170,6 +203,7 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         C_M=ufl.diag(ufl.as_vector([C[3], C[4], C[5]])),
         dx_shear=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p - 1}),
         dx=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p}),
+        matrices=matrices,
     )
 
 
@@ -191,13 +225,33 @@ class Discretisation:
     inertia: object  #: DG Function (ρA, ρI_1, ρI_2, ρI_3)
     stiffness_scale: float  #: largest EA, GA_y or GA_z before the limits (all ranks)
     reference: object  #: DG0 Function: orientation vector of each cell (global axes)
-    twist: object  #: DG0 Function: twist of each cell (radians)
+    twist: object  #: DG0 Function: twist of each cell (radians); DG_p if it varies along a beam
     t0: object  #: UFL unit tangent of the reference centre line
     Lam0: object  #: UFL reference section frame Λ0 (columns t0, e2, e3)
     C_N: object  #: UFL diag(EA, GA_y, GA_z)
     C_M: object  #: UFL diag(GJ, EI_y, EI_z)
     dx_shear: object  #: measure of the shear and axial energy (degree 2p − 1)
     dx: object  #: measure of everything else (degree 2p)
+    matrices: object = None  #: :class:`SectionMatrices`, or None: every section is diagonal
+
+    def strain_energy(self, Gamma, K, scale=None):
+        """The strain energy of the sections (times ``scale``, e.g. a damping time, if given):
+        :func:`~beamfx.physics.energy.strain_energy` with C_N, C_M for diagonal sections, the
+        coupled form :func:`~beamfx.physics.coupled.strain_energy` with a matrix section."""
+        if self.matrices is None:
+            if scale is None:
+                return energy.strain_energy(Gamma, K, self.C_N, self.C_M, self.dx_shear, self.dx)
+            return energy.strain_rate_dissipation(
+                Gamma, K, self.C_N, self.C_M, scale, self.dx_shear, self.dx
+            )
+        C = self.matrices.C if scale is None else scale * self.matrices.C
+        return coupled.strain_energy(Gamma, K, C, self.dx_shear, self.dx)
+
+    def resultants(self, Gamma, K):
+        """Section force and moment (N, M) of the strains (Γ, K), section axes."""
+        if self.matrices is None:
+            return self.C_N * Gamma, self.C_M * K
+        return coupled.resultants(Gamma, K, self.matrices.C)
 
     def cell_arc_lengths(self, X):
         """Arc length of the reference points ``X`` (in [0, 1]) of each local cell."""

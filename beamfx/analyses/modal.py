@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 import ufl
 
+from ..physics import coupled
 from ..physics.inertia import mass_form, point_mass_form
 from ..solvers.eigen import solve_eigen
 from ..solvers.forms import compile_form
@@ -35,7 +36,10 @@ def mass_ufl(model, rotary="full"):
     dw = ufl.split(ufl.TrialFunction(model.W))
     rot = ufl.split(model.w)[1]
     d = model.discretisation
-    m = mass_form(model.kin, rot, v, dw, d.inertia, d.Lam0, d.dx, rotary)
+    if d.matrices is None:
+        m = mass_form(model.kin, rot, v, dw, d.inertia, d.Lam0, d.dx, rotary)
+    else:
+        m = coupled.mass_form(model.kin, rot, v, dw, d.matrices.M, d.Lam0, d.dx, rotary)
     return m + d.point_mass_terms(
         lambda pm: point_mass_form(model.kin, rot, v, dw, pm.mass, pm.inertia)
     )

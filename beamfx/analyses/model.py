@@ -10,7 +10,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from ..physics import energy
+from ..physics import coupled, energy
 from ..physics.kinematics import displacement, rotation_output, rotation_vector, strains
 from ..physics.rotations import np_quaternion
 from ..spec import DOF_NAMES
@@ -79,7 +79,7 @@ class BeamModel(Discretised):
         test = ufl.TestFunction(self.W)
         v_u, v_rot = ufl.split(test)
         Gamma, K = strains(kin, u, rot, d.t0, d.Lam0)
-        Pi = energy.strain_energy(Gamma, K, d.C_N, d.C_M, d.dx_shear, d.dx)
+        Pi = d.strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, d.dx)
         for sp in spec.springs:
@@ -111,6 +111,9 @@ class BeamModel(Discretised):
         if any(spec.gravity):
             rho_A = d.inertia[0]
             work += rho_A * ufl.dot(vec(spec.gravity), displacement(kin, v_u)) * d.dx
+            if d.matrices is not None:  # the moment of the weight of an offset mass centre
+                g = vec(spec.gravity)
+                work += coupled.gravity_moment_work(kin, rot, v_rot, d.Lam0, d.matrices.M, g) * d.dx
         self.Pi = Pi
         self.F = ufl.derivative(Pi, self.w, test)
         self.work = None  # virtual work of the loads at load factor 1 (None: no loads)
@@ -261,8 +264,7 @@ class BeamModel(Discretised):
             displacement(self.kin, u),
             rotation_output(self.kin, rot),
             d.Lam0,
-            d.C_N * Gamma,
-            d.C_M * K,
+            *d.resultants(Gamma, K),
         )
 
     def unknowns(self):

@@ -30,6 +30,7 @@ from ..solvers.forms import compile_form
 from ..solvers.quadratic import solve_quadratic
 from .dofs import owned_size, subspace_dofs
 from .modal import mass_ufl
+from .section_fields import offset_inertia
 from .static import StaticResult, load_scale, solve_static
 
 ROTARY = ("full", "none")
@@ -75,18 +76,21 @@ class RotatingFrame:
         rho_A = d.inertia[0]
         rho_I = [d.inertia[i] for i in (1, 2, 3)]
         J = spatial_inertia(kin, rot, d.Lam0, rho_I) if rotary == "full" else ufl.zero((3, 3))
+        s = None  # first moment of an offset mass centre (matrix sections)
+        if d.matrices is not None:
+            J, s = offset_inertia(model, rot, rotary)
         v_u3, v_theta = displacement(kin, v_u), spatial_virtual_rotation(kin, rot, v_rot)
 
         def point_J(pm):
             return point_inertia(kin, rot, pm.inertia)
 
-        V_c = centrifugal_potential(rho_A, J, self.omega, r) * d.dx
+        V_c = centrifugal_potential(rho_A, J, self.omega, r, s) * d.dx
         V_c += d.point_mass_terms(
             lambda pm: centrifugal_potential(float(pm.mass), point_J(pm), self.omega, r)
         )
         self.F = model.F + model.load_factor * ufl.derivative(V_c, w, test)
         self.J = ufl.derivative(self.F, w, trial)
-        a = gyroscopic_covector(rho_A, J, self.omega, r, v_u3, v_theta) * d.dx
+        a = gyroscopic_covector(rho_A, J, self.omega, r, v_u3, v_theta, s) * d.dx
         a += d.point_mass_terms(
             lambda pm: gyroscopic_covector(
                 float(pm.mass), point_J(pm), self.omega, r, v_u3, v_theta

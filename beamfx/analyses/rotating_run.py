@@ -16,12 +16,36 @@ from .result import Result as _Base
 from .result import entry
 
 
+def _hub(value, fail):
+    """A hub: a named point (string) or three finite coordinates."""
+    if isinstance(value, str):
+        return value
+    ok = isinstance(value, list) and len(value) == 3
+    ok = ok and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+    if not ok or not all(abs(float(v)) < float("inf") for v in value):
+        fail(f"expected a named point or [x, y, z] (three finite numbers), got {value!r}")
+    return tuple(float(v) for v in value)
+
+
+def hub_position(spec, hub):
+    """The hub's coordinates: a named point's, or the ones given."""
+    from ..spec import resolve_point
+
+    return resolve_point(spec, hub)[2] if isinstance(hub, str) else np.asarray(hub, float)
+
+
 @dataclass(frozen=True)
 class Settings:
     """``[analysis]`` of a rotating analysis."""
 
     axis: Vec3 = option((0.0, 0.0, 1.0), doc="spin axis (global axes, any length)")
-    hub: str | None = option(None, doc="named point on the spin axis (default: the first support)")
+    hub: object = option(
+        None,
+        doc="point on the spin axis: a named point or [x, y, z] anywhere, on a beam or not "
+        "(default: the first support)",
+        parse=lambda value, fail: _hub(value, fail),
+        word="a named point or [x, y, z]",
+    )
     modes: int = option(6, positive=True, doc="modes per speed")
     rotary_inertia: str = option("full", choices=("full", "none"), doc="rotary inertia")
     speeds_rad_s: tuple[float, ...] | None = option(None, doc="spin speeds (rad/s), in order")
@@ -43,9 +67,11 @@ class Settings:
         return {"hub": model.supports[0].at} if model.supports else {}
 
     def problems_in(self, model: Model) -> Iterator[tuple[str, str]]:
-        """The hub must be a point of the model."""
+        """A named hub must be a point of the model (coordinates may lie anywhere)."""
         from ..spec import resolve_point
 
+        if not isinstance(self.hub, str):
+            return
         try:
             resolve_point(model, self.hub)
         except ValueError as e:
@@ -92,15 +118,15 @@ def _branches(result):
 
 def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Steady state and frequencies at every speed; the Campbell files in the output folder."""
-    from ..spec import resolve_point
     from .campbell import campbell, write_campbell
     from .rotating import RotatingFrame
 
     ctx.require_mass(model, "rotating")
-    hub = resolve_point(ctx.spec, settings.hub)[2]
+    hub = hub_position(ctx.spec, settings.hub)
     frame = RotatingFrame(model, settings.axis, hub, settings.rotary_inertia)
     ctx.log(
-        f"rotating about {frame.axis.round(6).tolist()} through {settings.hub} "
+        f"rotating about {frame.axis.round(6).tolist()} through "
+        f"{settings.hub if isinstance(settings.hub, str) else 'the hub'} "
         f"{np.round(hub, 6).tolist()}, {len(settings.speeds)} speed(s)"
     )
     result = campbell(
@@ -128,7 +154,10 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         newton_iterations=int(sum(s.iterations for s in steps)),
         seconds={"total": float(sum(s.seconds["total"] for s in result.steady))},
         axis=tuple(frame.axis.tolist()),
-        hub={"at": settings.hub, "position": np.asarray(hub).tolist()},
+        hub={
+            "at": settings.hub if isinstance(settings.hub, str) else None,
+            "position": np.asarray(hub).tolist(),
+        },
         rotary_inertia=settings.rotary_inertia,
         speeds_rad_s=tuple(result.speeds.tolist()),
         frequencies_hz=tuple(result.frequencies_hz.tolist()),

@@ -24,8 +24,8 @@ from typing import NamedTuple
 import numpy as np
 import ufl
 
-from ..physics.energy import strain_rate_dissipation
-from ..physics.inertia import angular_velocity, kinetic_energy, point_kinetic_energy
+from ..physics import coupled
+from ..physics.inertia import angular_velocity, point_kinetic_energy
 from ..physics.kinematics import displacement, strains
 from ..solvers import NewtonSolver
 from ..solvers.integrators import AlphaStep, generalized_alpha, hht, newmark
@@ -34,6 +34,7 @@ from ..solvers.step_control import EasyGrowth, ErrorBased, StepControl, StepTooS
 from .checks import model_size
 from .conserving import Projection
 from .dofs import constrained_dofs, owned_size, subspace_dofs
+from .section_fields import section_kinetic_energy
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
 
@@ -130,7 +131,7 @@ class Dynamics:
 
         def T_of(q, v):
             (_, rot), (u_dot, rot_dot) = ufl.split(q), ufl.split(v)
-            T = kinetic_energy(kin, rot, u_dot, rot_dot, d.inertia, d.Lam0, settings.rotary_inertia)
+            T = section_kinetic_energy(kin, rot, u_dot, rot_dot, d, settings.rotary_inertia)
             u_dot3, omega = displacement(kin, u_dot), angular_velocity(kin, rot, rot_dot)
             return T * d.dx + d.point_mass_terms(
                 lambda pm: point_kinetic_energy(kin, rot, u_dot3, omega, pm.mass, pm.inertia)
@@ -147,7 +148,7 @@ class Dynamics:
             u, rot = ufl.split(w)
             Gamma, K = strains(kin, u, rot, d.t0, d.Lam0)
             rate = [ufl.derivative(x, w, V) for x in (Gamma, K)]
-            D = strain_rate_dissipation(*rate, d.C_N, d.C_M, a1, d.dx_shear, d.dx)
+            D = d.strain_energy(*rate, scale=a1)
             inertia += ufl.derivative(D, V, test)
             power += 2 * D
         v_expr, qdd_expr = self.scheme.rates(w, self.q_n, self.v_n, self.a_n, self.qdd_n)
@@ -175,7 +176,12 @@ class Dynamics:
         omega = angular_velocity(kin, rot, rot_dot)
         p = d.inertia[0] * velocity
         L = ufl.cross(x, p)
-        if rotary != "none":
+        if d.matrices is not None:  # ∂T/∂u̇ and ∂T/∂ω of the offset mass: + ω × s, + s × u̇
+            s = coupled.first_moment(kin, rot, d.Lam0, d.matrices.M)
+            p += ufl.cross(omega, s)
+            L = ufl.cross(x, p) + ufl.cross(s, velocity)
+            L += coupled.spatial_rotary(kin, rot, d.Lam0, d.matrices.M) * omega
+        elif rotary != "none":
             J = spatial_inertia(kin, rot, d.Lam0, [d.inertia[i] for i in (1, 2, 3)], rotary)
             L += J * omega
 

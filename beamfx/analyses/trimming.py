@@ -64,8 +64,19 @@ def _symmetric(section, rtol=1e-12):
     return all(abs(a - b) <= rtol * max(abs(a), abs(b), 1e-300) for a, b in pairs)
 
 
+def _matrix(model):
+    """Why a model with a matrix (6×6) section is neither planar nor condensed, or None."""
+    for b in model.beams:
+        if not hasattr(b.section, "EA"):
+            return f"beam {b.name!r} has a matrix section (its couplings may leave a plane)"
+    return None
+
+
 def _principal(model, n):
     """None if n is a principal axis of every section (or the section is symmetric)."""
+    why = _matrix(model)
+    if why:
+        return why
     for b in model.beams:
         s = np.linspace(0.0, b.curve.length, 21)
         frames = [section_axes_at(b.curve, si, b.orientation, b.twist_deg) for si in s]
@@ -197,6 +208,8 @@ def condensed_fit(model, analysis="static"):
         return "distributed loads (and gravity) are not implemented in it"
     if model.springs or model.point_masses:
         return "springs and point masses are not implemented in it"
+    if _matrix(model):
+        return _matrix(model)
     for ld in model.point_loads:
         if ld.history is not None:
             return "a load has a history"

@@ -15,6 +15,7 @@ def all_cases():
     from . import (  # noqa: F401
         adaptive_bend45,
         classic,
+        coupled_cantilever,
         howcroft_2016,
         pai_beam,
         planar_rollup,

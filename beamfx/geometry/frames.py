@@ -60,5 +60,8 @@ def tangent_at(curve, s, rel_step=1e-6):
 
 def section_axes_at(curve, s, orientation=None, twist_deg=0.0):
     """Section frame Λ0 (columns t, e2, e3) of a beam on ``curve`` at arc length ``s``, with
-    its ``orientation`` vector and ``twist_deg`` (:func:`frame_from_tangent`)."""
+    its ``orientation`` vector and ``twist_deg`` (:func:`frame_from_tangent`; a number, or a
+    function of the arc length)."""
+    if callable(twist_deg):
+        twist_deg = float(np.asarray(twist_deg(np.array([s], float)))[0])
     return frame_from_tangent(tangent_at(curve, s), orientation, twist_deg)

@@ -17,6 +17,11 @@ which splits by powers of the rates into T = T₂ + T₁ + T₀:
 
 Ω, r and J are in the global axes of the rotating frame. For quaternions w = spatial_rate(q, q̇)
 is blind to the norm of q (as is J), so a and G see only the rotation q/|q|.
+
+A section whose mass centre is off the reference line (first moment s = Λ S, global axes; a
+matrix section) adds (ṙ + Ω × r)·((w + Ω) × s) to T: ṙ·(w × s) to T₂ (the mass matrix),
+ṙ·(Ω × s) + (Ω × r)·(w × s) to T₁ and (Ω × r)·(Ω × s) to T₀; J is then about the reference
+point.
 """
 
 from .rotations import hat
@@ -27,22 +32,30 @@ def relative_position(X, u, hub):
     return X + u - hub
 
 
-def centrifugal_potential(rho_A, J, omega, r):
-    r"""V_c = −½ ρA |Ω × r|² − ½ Ω·J Ω per unit length; J is the spatial section inertia."""
+def centrifugal_potential(rho_A, J, omega, r, s=None):
+    r"""V_c = −½ ρA |Ω × r|² − ½ Ω·J Ω per unit length; J is the spatial section inertia
+    (and − (Ω × r)·(Ω × s) with the first moment ``s``)."""
     import ufl
 
-    return -0.5 * rho_A * ufl.dot(ufl.cross(omega, r), ufl.cross(omega, r)) - 0.5 * ufl.dot(
+    V = -0.5 * rho_A * ufl.dot(ufl.cross(omega, r), ufl.cross(omega, r)) - 0.5 * ufl.dot(
         omega, J * omega
     )
+    if s is not None:
+        V -= ufl.dot(ufl.cross(omega, r), ufl.cross(omega, s))
+    return V
 
 
-def gyroscopic_covector(rho_A, J, omega, r, v_u, v_theta):
+def gyroscopic_covector(rho_A, J, omega, r, v_u, v_theta, s=None):
     r"""a(q)·δq = ρA δu·(Ω × r) + δθ·J Ω: the coefficient of the rates in T₁, tested with the
     virtual displacement δu and the virtual spatial rotation δθ (global axes).
 
     G(δ, Δ) = ∂a/∂q[Δ]·δ − ∂a/∂q[δ]·Δ; for the centre line alone that is
-    2 ρA δu·(Ω × Δu), the Coriolis force 2 ρA Ω × u̇.
+    2 ρA δu·(Ω × Δu), the Coriolis force 2 ρA Ω × u̇. With the first moment ``s``:
+    + δu·(Ω × s) + δθ·(s × (Ω × r)).
     """
     import ufl
 
-    return rho_A * ufl.dot(v_u, hat(omega) * r) + ufl.dot(v_theta, J * omega)
+    a = rho_A * ufl.dot(v_u, hat(omega) * r) + ufl.dot(v_theta, J * omega)
+    if s is not None:
+        a += ufl.dot(v_u, ufl.cross(omega, s)) + ufl.dot(v_theta, ufl.cross(s, ufl.cross(omega, r)))
+    return a

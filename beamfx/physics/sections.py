@@ -49,6 +49,11 @@ class Section:
         """Mass per length and the section inertia diagonal: (rho_A, rho_I...)."""
         return np.r_[self.rho_A, self.rho_I]
 
+    def matrices(self):
+        """(C, M): the 6×6 stiffness diag(EA, GA_y, GA_z, GJ, EI_y, EI_z) and mass
+        diag(ρA, ρA, ρA, ρI...) in the order of :mod:`~beamfx.physics.matrix_sections`."""
+        return np.diag(self.stiffnesses()), np.diag(np.r_[[self.rho_A] * 3, self.rho_I])
+
     varies = False
 
     def along(self, s):

@@ -19,6 +19,7 @@ from .files import read_toml
 from .limits import read_limits, unknowns
 from .loads import read_loads, read_masses, read_springs, read_supports
 from .section import read_material, read_section
+from .sections import read_twist
 from .table import SceneError, Table
 
 
@@ -171,7 +172,7 @@ def _beams(top, mat, base, limits):
             t.fail("name", f"{name!r} must be unique and contain no ':'")
         names.add(name)
         curve = read_curve(t.table("curve"), base, limits)
-        section = read_section(t.table("section"), mat, curve.length)
+        section = read_section(t.table("section"), mat, curve.length, base)
         beams.append(
             Beam(
                 name,
@@ -180,7 +181,7 @@ def _beams(top, mat, base, limits):
                 t.get("elements", int, 8, positive=True),
                 t.get("degree", int, 2, choices=(1, 2, 3, 4)),
                 t.get("orientation", "vec3", None),
-                t.get("twist_deg", float, 0.0),
+                read_twist(t, curve.length),
             )
         )
         t.done()

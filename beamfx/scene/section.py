@@ -2,14 +2,16 @@
 or tables along the beam, every value checked finite and in range along the whole beam."""
 
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 
 from ..physics import sections
 from .expr import compile_expression, table_function
+from .sections import beamdyn_section, matrix_section, offsets, with_offsets
 from .table import MAX_MAGNITUDE, Table, is_number
 
-SECTION_TYPES = ("rectangle", "circle", "tube", "general")
+SECTION_TYPES = ("rectangle", "circle", "tube", "general", "matrix", "beamdyn")
 _SAMPLES = 201  # points along the beam where a varying value is checked
 _EXPRESSION_ERRORS = (ValueError, TypeError, ZeroDivisionError, FloatingPointError, OverflowError)
 
@@ -59,10 +61,17 @@ def along(t, key, length, default=..., positive=True):
     return value
 
 
-def read_section(t, mat, length):
+def read_section(t, mat, length, base=Path(".")):
     """A Section, or a SectionAlong if a value varies along the beam (``mat``: the
-    material's (E, G, rho, nu) or None; ``length``: the beam's)."""
+    material's (E, G, rho, nu) or None; ``length``: the beam's); a MatrixSection for the
+    types "matrix" and "beamdyn" (files relative to ``base``) or with offset keys
+    (:mod:`beamfx.scene.sections`)."""
     kind = t.get("type", str, choices=SECTION_TYPES)
+    if kind == "matrix":
+        return matrix_section(t, length)
+    if kind == "beamdyn":
+        return beamdyn_section(t, length, base)
+    given = offsets(t)
     k = t.get("shear_factor", float, None, positive=True)
     value = partial(along, t, length=length)
     if kind == "general":
@@ -104,8 +113,10 @@ def read_section(t, mat, length):
                 t.fail("d_inner", "must satisfy 0 <= d_inner < d along the whole beam")
     t.done()
     if any(callable(v) for v in params.values()):
-        return sections.SectionAlong(make, params)
-    return make(**params)
+        section = sections.SectionAlong(make, params)
+    else:
+        section = make(**params)
+    return with_offsets(t, section, given, length) if given else section
 
 
 def read_material(t):

@@ -25,9 +25,10 @@ def spec_from_scene(scene, material=None, mesh=None, solver="auto"):
             f"{file}: beams: the solid takes one beam, the scene has {len(model.beams)}"
         )
     beam = model.beams[0]
-    if beam.section.varies or not beam.section.shape:
+    if beam.section.varies or not beam.section.shape or callable(beam.twist_deg):
         raise SceneError(
-            f"{file}: beams[0].section: the solid needs a prismatic rectangle, circle or tube"
+            f"{file}: beams[0].section: the solid needs a prismatic rectangle, circle or tube "
+            "(and a constant twist_deg)"
         )
     for what, items in (
         ("distributed loads", model.distributed_loads),

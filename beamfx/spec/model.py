@@ -20,7 +20,7 @@ class Beam:
     elements: int
     degree: int = 2
     orientation: tuple | None = None  # reference vector for the section z axis (global)
-    twist_deg: float = 0.0
+    twist_deg: float = 0.0  # or a function of the arc length s (pre-twist along the span)
 
 
 AXES = ("global", "local")
