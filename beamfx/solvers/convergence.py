@@ -13,7 +13,8 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
 * **floor**: ‖F‖ ≤ :data:`FLOOR_FACTOR` × the round-off floor ε‖ |K| (|x| + s) ‖ (|K| the
   tangent's entries in absolute value, s a size per unknown added to the state, e.g. the
   element length for displacements, so that the terms of the reference geometry count), and
-  ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too),
+  ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too, or
+  the floor is the model's own at its reference geometry: a small load on a stiff model),
   *and* the increment criteria hold: the last correction is small against the state,
   ‖du‖ ≤ :data:`INCREMENT_TOL`·‖|x| + s‖ (or :data:`SETTLED_TOL`·‖|x| + s‖ once the
   corrections stagnate: round-off moves the state, Newton no longer does), and its
@@ -121,10 +122,16 @@ class AbsoluteTangent:
         rows, cols, vals = self.B.getValuesCSR()
         self.B.setValuesCSR(rows, cols, np.abs(vals))
         self.B.assemble()
+        eps = np.finfo(float).eps
+        self.geometry = 0.0  # the part of the reference geometry alone: ε‖ |A| sizes ‖₂
+        if sizes is not None:
+            self.v.setArray(sizes)
+            self.B.mult(self.v, self.out)
+            self.geometry = float(eps * self.out.norm())
         state = np.abs(x.getArray(readonly=True))
         self.v.setArray(state if sizes is None else state + sizes)
         self.B.mult(self.v, self.out)
-        return float(np.finfo(float).eps * self.out.norm())
+        return float(eps * self.out.norm())
 
     def destroy(self):
         """Free the PETSc objects."""
@@ -192,20 +199,27 @@ class ScaledTest:
         if relative and self.increment_small(record, x):
             self.how = "relative"
             return self.how
-        # with no load, the reactions are round-off too: nothing to resolve beyond the floor
-        unloaded = s.force_scale == 0.0
-        if fnorm > FLOOR_LIMIT * scale and not unloaded:
-            return None
         if self.floor is None:  # once per solve: the tangent hardly changes at this stage
             self.floor = self.absolute.floor(s.A, x, s.sizes)
+            self.geometry_floor = self.absolute.geometry
         record["floor"] = self.floor
-        unloaded = unloaded and scale <= FLOOR_FACTOR * self.floor
-        if fnorm > FLOOR_FACTOR * self.floor or (fnorm > FLOOR_LIMIT * scale and not unloaded):
+        if fnorm > FLOOR_FACTOR * self.floor or not self._resolvable(fnorm, scale):
             return None
         if not self.increment_small(record, x):
             return None
+        record["resolved"] = fnorm / scale if scale > 0 else None
         self.how = "floor"
         return self.how
+
+    def _resolvable(self, fnorm, scale):
+        """Whether a residual at the floor may be accepted against the force scale: below
+        FLOOR_LIMIT·S; or without any load (the reactions are round-off too); or when the
+        floor is that of the model at its own reference geometry (a small load on a model
+        with a stiff term: nothing resolves it better, and the settled increments say the
+        state is exact to round-off), but not when a huge state raised it."""
+        unloaded = self.solver.force_scale == 0.0 and scale <= FLOOR_FACTOR * self.floor
+        geometric = self.geometry_floor >= 0.5 * self.floor
+        return fnorm <= FLOOR_LIMIT * scale or unloaded or geometric
 
     def linear(self, x, fnorm):
         """The test after one linear solve (``snes_type ksponly``): the residual criterion, or
