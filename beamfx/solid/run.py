@@ -3,7 +3,6 @@ beam at the probes on the end faces (results.json, results.md, solid.pvd)."""
 
 import resource
 import time
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -68,7 +67,9 @@ def spec_from_scene(scene, material=None, mesh=None, solver="auto"):
 
 def _material(file):
     """E, nu, rho of the scene's [material] table (the section holds only products)."""
-    data = tomllib.loads(Path(file).read_text())
+    from ..scene.files import read_toml
+
+    data = read_toml(file)  # the guarded reader (size, UTF-8, nesting); numbers checked by load
     mat = data.get("material")
     if not isinstance(mat, dict) or "E" not in mat:
         raise SceneError(f"{file}: material.E: the solid needs [material] with E and nu")
