@@ -78,6 +78,7 @@ register(
         None,
         1e-6,
         tuple((n, p) for p in (3, 4) for n in (4, 8, 16, 32)),  # 2 cubics: no membrane state
+        scale=THEORY["q_shallow"],  # error relative to the load (the bracket is a width)
         note='Arc-length trace of the scene as shipped (7500 N/m, branch = "secondary"): '
         "q_bifurcation is the located point (regula falsi on the arc length; q_bracket the "
         "width of the load interval the inertia puts it in), q_buckling the in-plane linear "
