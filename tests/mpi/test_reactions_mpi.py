@@ -1,0 +1,75 @@
+"""Run under ``mpirun -n 2``: the support reactions of a frame are the same from all ranks as
+from one process (each rank sums its owned dofs; the sums are reduced)."""
+
+import tomllib
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from beamfx.analyses.model import BeamModel
+from beamfx.analyses.reactions import entries
+from beamfx.analyses.static import solve_static
+from beamfx.scene.load import parse_scene
+
+pytestmark = pytest.mark.mpi
+
+FRAME = """
+[material]
+E = 210e9
+nu = 0.3
+rho = 7850
+[[beams]]
+name = "left"
+curve = { shape = "line", start = [0, 0, 0], end = [0, 0, 3] }
+section = { type = "rectangle", h = 0.2, w = 0.1 }
+elements = 6
+[[beams]]
+name = "top"
+curve = { shape = "line", start = [0, 0, 3], end = [4, 1, 3] }
+section = { type = "rectangle", h = 0.2, w = 0.1 }
+orientation = [0, 0, 1]
+elements = 6
+[[beams]]
+name = "right"
+curve = { shape = "line", start = [4, 1, 3], end = [4, 1, 0] }
+section = { type = "rectangle", h = 0.2, w = 0.1 }
+elements = 6
+[[supports]]
+at = "left:start"
+fix = "all"
+[[supports]]
+at = "right:end"
+fix = "pinned"
+[[springs]]
+at = "top:0.5"
+stiffness = [0, 1e6, 0]
+[[loads]]
+at = "top:0.25"
+force = [2e4, 3e3, -5e4]
+moment = [0, 1e3, 0]
+[[loads]]
+gravity = [0, 0, -9.81]
+[model]
+kinematics = "KIN"
+plane = "none"
+"""
+
+
+@pytest.mark.parametrize("kin", ["linear", "finite"])
+def test_frame_reactions_match_serial(kin):
+    spec = parse_scene(tomllib.loads(FRAME.replace("KIN", kin))).model
+    out = {}
+    for comm in (MPI.COMM_SELF, MPI.COMM_WORLD):
+        model = BeamModel(spec, comm)
+        solve_static(model, steps=2)
+        out[comm.size] = entries(model)
+    parallel, serial = out[MPI.COMM_WORLD.size], out[1]
+    assert set(parallel["reactions"]) == {"left:start", "right:end", "top:0.5"}
+    for at, r in serial["reactions"].items():
+        for key in ("force", "moment", "position"):
+            a, b = np.asarray(parallel["reactions"][at][key]), np.asarray(r[key])
+            assert np.allclose(a, b, rtol=1e-9, atol=1e-9 * 6e4), (at, key, a, b)
+    for result in (serial, parallel):
+        assert result["reaction_balance"]["force"] < 1e-9
+        assert result["reaction_balance"]["moment"] < 1e-9
