@@ -106,8 +106,9 @@ class BeamModel(Discretised):
             return energy.load_work(kin, rot, v_u, v_rot, force, moment, load.kind, load.arm)
 
         work = 0
-        for ld in spec.point_loads:
-            work += self._history_factor(ld) * d.at_point(ld.at, work_of(ld))
+        for ld in spec.point_loads:  # constant on a cell: dead forces, moments if θ is linear
+            exact = ld.kind == "dead" and not (kin.finite and not kin.plane and any(ld.moment))
+            work += self._history_factor(ld) * d.at_point(ld.at, work_of(ld), exact)
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
             on_beam = 1.0 if dl.beam is None else d.beam_indicator(names.index(dl.beam))
