@@ -1,10 +1,9 @@
 """Line meshes of frames (towers, domes, lattices) read from a mesh file: nodes, straight
 members and the named groups of members and nodes.
 
-A gmsh ``.msh`` file (format 2.2 or 4.1, ASCII or binary) is read with meshio, which needs no
-gmsh session: its physical groups of dimension 1 name groups of members, those of dimension 0
-groups of nodes. Other meshio formats give members without groups. Each two-node line element
-is one straight member. Knows nothing of sections or supports (:mod:`beamfx.scene.frames`
+A gmsh ``.msh`` file (format 2.2 or 4.1, ASCII or binary) is read with meshio's gmsh reader,
+which needs no gmsh session: its physical groups of dimension 1 name groups of members, those
+of dimension 0 groups of nodes. Each two-node line element is one straight member. Knows nothing of sections or supports (:mod:`beamfx.scene.frames`
 maps the groups to them).
 """
 
@@ -57,10 +56,10 @@ def read_line_mesh(path):
         ValueError: naming the file, if it does not parse, holds no line element, has
             non-finite coordinates or zero-length members.
     """
-    import meshio
+    import meshio.gmsh
 
-    try:
-        mesh = meshio.read(str(path))
+    try:  # the format's reader itself: meshio.read would print and sys.exit on a bad file
+        mesh = meshio.gmsh.read(str(path))
     except Exception as e:  # noqa: BLE001 (meshio readers raise ReadError, KeyError, ...)
         raise ValueError(f"{path}: not a mesh meshio can read ({type(e).__name__}: {e})") from None
     points = np.asarray(mesh.points, float)

@@ -1,0 +1,142 @@
+"""``[[frames]]``: frames read from a mesh file (beamfx.scene.frames) run as scenes, their
+reactions balance the loads, and bad input fails naming the file, the key and the group."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beamfx.geometry.line_mesh import read_line_mesh, write_line_mesh
+from beamfx.runner import run_scene
+from beamfx.scene import SceneError, load_scene
+
+DEMOS = Path(__file__).resolve().parents[2] / "demos" / "scenes"
+
+# a tripod: three tubes from the ground to an apex, clamped feet, a load at the apex
+POINTS = [[0, 0, 0], [2, 0, 0], [0, 2, 0], [0.7, 0.7, 2.0]]
+MEMBERS = [[0, 3], [1, 3], [2, 3]]
+
+SCENE = """
+[material]
+E = 210e9
+nu = 0.3
+rho = 7850
+[[frames]]
+name = "tri"
+mesh = "tripod.msh"
+elements = 2
+[[frames.members]]
+group = "legs"
+section = { type = "tube", d = 0.1, d_inner = 0.09 }
+[[frames.supports]]
+group = "feet"
+fix = "all"
+[[frames.loads]]
+group = "apex"
+force = [1e3, 2e3, -1e4]
+[[frames.probes]]
+group = "apex"
+[[loads]]
+gravity = [0, 0, -9.81]
+[model]
+kinematics = "KIN"
+[analysis]
+type = "static"
+steps = 2
+"""
+
+
+@pytest.fixture
+def tripod(tmp_path):
+    """``tripod(text, **groups) -> scene path``: the tripod mesh and a scene beside it."""
+
+    def write(text=SCENE, members=None, nodes=None):
+        text = text.replace("KIN", "linear")
+        groups = members if members is not None else {"legs": [0, 1, 2]}
+        nodes = nodes if nodes is not None else {"feet": [0, 1, 2], "apex": [3]}
+        write_line_mesh(tmp_path / "tripod.msh", POINTS, MEMBERS, groups, nodes)
+        (tmp_path / "scene.toml").write_text(text)
+        return tmp_path / "scene.toml"
+
+    return write
+
+
+def test_mesh_round_trip(tmp_path):
+    write_line_mesh(tmp_path / "t.msh", POINTS, MEMBERS, {"legs": [0, 1, 2]}, {"apex": [3]})
+    mesh = read_line_mesh(tmp_path / "t.msh")
+    assert np.array_equal(mesh.points, POINTS) and mesh.members.tolist() == MEMBERS
+    assert mesh.member_groups["legs"].tolist() == [0, 1, 2]
+    assert mesh.node_groups == {"apex": [3]}
+
+
+@pytest.mark.parametrize("kin", ["linear", "finite"])
+def test_tripod_runs_and_its_reactions_balance_the_loads(tripod, tmp_path, kin):
+    """The apex joins three members: its dead load acts through the joint density; the
+    reactions at the three feet balance it and the weight (1e-9: the Newton tolerance)."""
+    run = run_scene(tripod(SCENE.replace("KIN", kin)), tmp_path / "out", log=lambda m: None)
+    assert run["model"]["beams"] == ["tri.1", "tri.2", "tri.3"]
+    assert set(run["reactions"]) == {"tri.1:start", "tri.2:start", "tri.3:start"}
+    bal = run["reaction_balance"]
+    assert bal["force"] < 1e-9 and bal["moment"] < 1e-9
+    length = sum(np.linalg.norm(np.subtract(POINTS[3], POINTS[i])) for i in range(3))
+    weight = 7850 * np.pi / 4 * (0.1**2 - 0.09**2) * length * 9.81
+    assert bal["applied_force"] == pytest.approx([1e3, 2e3, -1e4 - weight], rel=1e-6)
+    assert "apex" in run["probes"]
+
+
+@pytest.mark.parametrize("name", ["tower", "dome"])
+def test_demo_frames_run_and_balance(name, tmp_path):
+    run = run_scene(DEMOS / f"{name}.toml", tmp_path / "out", log=lambda m: None)
+    assert run.converged
+    bal = run["reaction_balance"]
+    assert bal["force"] < 1e-9 and bal["moment"] < 1e-9
+
+
+def _error(path):
+    with pytest.raises(SceneError) as e:
+        load_scene(path)
+    return str(e.value)
+
+
+def test_missing_and_unreadable_mesh_files(tripod, tmp_path):
+    path = tripod(SCENE.replace("tripod.msh", "nothing.msh"))
+    assert "frames[0].mesh: no such file" in _error(path)
+    path = tripod()
+    (tmp_path / "tripod.msh").write_text("$MeshFormat\nnot a mesh\n")
+    message = _error(path)
+    assert "frames[0].mesh" in message and "tripod.msh: not a mesh meshio can read" in message
+    outside = tmp_path / "sub"
+    outside.mkdir()
+    shutil.copy(path, outside / "scene.toml")
+    text = SCENE.replace('"tripod.msh"', '"../tripod.msh"')
+    (outside / "scene.toml").write_text(text)
+    assert "is outside the scene file's folder" in _error(outside / "scene.toml")
+
+
+def test_groups_the_mesh_lacks_and_members_without_section(tripod):
+    text = SCENE.replace('group = "legs"', 'group = "struts"')
+    message = _error(tripod(text))
+    assert "frames[0].members[0].group: the mesh has no member (line) group 'struts'" in message
+    assert "['legs']" in message
+    message = _error(tripod(SCENE.replace('group = "feet"', 'group = "base"')))
+    assert "frames[0].supports[0].group: the mesh has no node (point) group 'base'" in message
+    message = _error(tripod(members={"legs": [0, 1]}))
+    assert "frames[0].members: 1 member(s) of the mesh have no section (first: tri.3" in message
+
+
+def test_bad_values_name_their_key(tripod):
+    text = SCENE.replace("force = [1e3, 2e3, -1e4]", "force = [nan, 0, 0]")
+    assert "frames[0].loads[0].force: must be finite numbers" in _error(tripod(text))
+    text = SCENE.replace("section = { type", "orientation = [0.7, 0.7, 2.0]\nsection = { type")
+    assert "frames[0].members[0].orientation" in _error(tripod(text))
+    text = SCENE.replace("elements = 2", "elements = 0")
+    assert "frames[0].elements: must be positive" in _error(tripod(text))
+    text = SCENE.replace('group = "apex"\nforce', 'group = "apex"\nforce_per_length')
+    assert "frames[0].loads[0]" in _error(tripod(text))
+
+
+def test_a_follower_load_at_a_joint_of_three_members_is_refused(tripod, tmp_path):
+    text = SCENE.replace("KIN", "finite").replace("force = [1e3", 'kind = "follower"\nforce = [1e3')
+    with pytest.raises(ValueError, match="joins 3 elements: only dead forces"):
+        run_scene(tripod(text), tmp_path / "out", log=lambda m: None)
