@@ -7,17 +7,10 @@ the nodes too, 1e-13 here; the tests use P3, exact everywhere.)"""
 
 from pathlib import Path
 
-import numpy as np
 import pytest
-from mpi4py import MPI
 
-from beamfx.analyses.model import BeamModel
-from beamfx.analyses.reactions import entries
-from beamfx.analyses.static import solve_static
-from beamfx.bench import frame_stiffness
-from beamfx.io import evaluate_points
+from beamfx.bench import frame_peers, frame_stiffness
 from beamfx.scene import load_scene
-from beamfx.spec import resolve_point
 
 DEMOS = Path(__file__).resolve().parents[2] / "demos" / "scenes"
 
@@ -69,28 +62,9 @@ type = "linear_static"
 def _compare(spec):
     """Max relative differences (translations, rotations, reactions) of beamfx's linear
     solution at every member end against the exact frame."""
-    ends = [f"{b.name}:{w}" for b in spec.beams for w in ("start", "end")]
-    model = BeamModel(spec, MPI.COMM_WORLD, extra_points=ends)
-    solve_static(model)
-    values = evaluate_points(model, ends)
-    problem = frame_stiffness.problem_from_model(spec)
-    exact, reactions = frame_stiffness.solve(problem)
-    index = {tuple(np.round(x / 1e-9).astype(np.int64)): i for i, x in enumerate(problem.nodes)}
-
-    def node(at):
-        return index[tuple(np.round(resolve_point(spec, at)[2] / 1e-9).astype(np.int64))]
-
-    got = np.array([np.r_[values[a]["displacement"], values[a]["rotation_vector"]] for a in ends])
-    want = exact[[node(a) for a in ends]]
-    err = [
-        np.abs(got[:, s] - want[:, s]).max() / np.abs(want[:, s]).max()
-        for s in (slice(0, 3), slice(3, 6))
-    ]
-    found = entries(model)["reactions"]
-    r_got = np.array([np.r_[found[a]["force"], found[a]["moment"]] for a in found])
-    r_want = np.array([reactions[node(a)] for a in found])
-    err.append(np.abs(r_got - r_want).max() / np.abs(r_want).max())
-    return err
+    u, reactions, _ = frame_peers.beamfx_frame(spec)
+    exact, exact_reactions = frame_stiffness.solve(frame_stiffness.problem_from_model(spec))
+    return frame_peers.differences(u, reactions, exact, exact_reactions)
 
 
 @pytest.mark.parametrize("elements", [1, 3])
@@ -102,20 +76,17 @@ def test_portal_frame_equals_the_exact_timoshenko_frame(scene_file, elements):
     assert max(errors) < 1e-8, errors
 
 
-def test_tower_equals_the_exact_frame_with_loads_at_many_member_joints():
-    """The 96-member tower of demos/scenes (joints of up to 6 elements, where point loads act
-    through the joint density of beamfx.analyses.joints), linear, P3, no gravity (a member
-    load is not a joint load), a moment added at one top node."""
+@pytest.mark.parametrize("name", frame_peers.FRAMES)
+def test_demo_frames_equal_the_exact_frame_with_loads_at_many_member_joints(name):
+    """The tower (96 members, joints of up to 6 elements) and the dome (156 members, 12 at
+    the crown) of demos/scenes, where point loads act through the joint density of
+    beamfx.analyses.joints; linear, P3, no gravity (a member load is not a joint load); a
+    moment added at the first loaded node."""
     from dataclasses import replace
 
-    from beamfx.physics.kinematics import Kinematics
     from beamfx.spec import PointLoad
 
-    spec = load_scene(DEMOS / "tower.toml").model
-    beams = tuple(replace(b, degree=3) for b in spec.beams)
-    loads = (*spec.point_loads, PointLoad(spec.point_loads[0].at, moment=(1e3, -2e3, 5e2)))
-    spec = replace(
-        spec, beams=beams, point_loads=loads, gravity=(0.0, 0.0, 0.0), kinematics=Kinematics(False)
-    )
-    errors = _compare(spec)
+    spec = frame_peers.linear_frame(load_scene(DEMOS / f"{name}.toml").model)
+    extra = PointLoad(spec.point_loads[0].at, moment=(1e3, -2e3, 5e2))
+    errors = _compare(replace(spec, point_loads=(*spec.point_loads, extra)))
     assert max(errors) < 1e-8, errors
