@@ -73,3 +73,20 @@ def test_frame_reactions_match_serial(kin):
     for result in (serial, parallel):
         assert result["reaction_balance"]["force"] < 1e-9
         assert result["reaction_balance"]["moment"] < 1e-9
+
+
+@pytest.mark.parametrize("name", ["tower", "dome"])
+def test_demo_frames_match_serial_and_the_exact_frame(name):
+    """The demo frames, linear: point loads at joints of many elements (the joint density
+    on an element that may sit on either rank) and the reactions of 4 or 12 supports."""
+    from pathlib import Path
+
+    from beamfx.bench import frame_peers, frame_stiffness
+    from beamfx.scene import load_scene
+
+    demos = Path(__file__).resolve().parents[2] / "demos" / "scenes"
+    spec = frame_peers.linear_frame(load_scene(demos / f"{name}.toml").model)
+    exact, exact_r = frame_stiffness.solve(frame_stiffness.problem_from_model(spec))
+    for comm in (MPI.COMM_SELF, MPI.COMM_WORLD):
+        u, reactions, _ = frame_peers.beamfx_frame(spec, comm)
+        assert max(frame_peers.differences(u, reactions, exact, exact_r)) < 1e-8, comm.size

@@ -246,5 +246,8 @@ def test_arclength_reactions_balance_along_the_path(tmp_path):
     bal = run["reaction_balance"]
     assert bal["force"] < 1e-9 and bal["moment"] < 1e-9
     assert set(run["reactions"]) == {"arch:start", "arch:end"}
+    path = run["path"]
+    assert path[-1]["reactions"] == run["reactions"]
+    assert len(path) == 7 and all("reactions" in p for p in path[1:])  # the start has none
     for r in run["reactions"].values():  # pinned about x: no moment about x
         assert abs(r["moment"][0]) < 1e-9 * np.abs(bal["applied_force"]).max()
