@@ -302,12 +302,13 @@ class Discretisation:
         ``cell_exact``: the integrand is linear in the test function with coefficients that
         are constant on a cell (a dead force); where more than two elements meet (a joint of a
         frame, where no facet measure reaches) it is then integrated exactly on one of them,
-        weighted by :func:`~beamfx.analyses.joints.joint_density`.
+        weighted by the density of :func:`~beamfx.analyses.joints.joint_density`.
         """
         if cell_exact and self.elements_at(at) > 2:
             from .joints import joint_density
 
-            return integrand * joint_density(self, at) * self.dx
+            psi = cell_field(self.mesh.mesh, self.degree, joint_density(self, at))
+            return integrand * psi * self.dx
         dP, side = self.point_measure(at)
         return (integrand(side) if side else integrand) * dP
 

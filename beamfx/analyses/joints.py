@@ -26,28 +26,25 @@ def kernel(xi, end, degree):
 
 
 def _cell_at(m, vertex, original):
-    """The element at ``vertex`` first in input order, and which end (0, 1) the vertex is."""
-    import dolfinx.cpp.mesh
-
+    """The element at ``vertex`` first in input order, and which end (0, 1) the vertex is (a
+    cell's vertices are in the order of its first two geometry nodes)."""
     cells = m.topology.connectivity(0, 1).links(vertex)
     c = int(cells[np.argmin(original[cells])])
-    node = dolfinx.cpp.mesh.entities_to_geometry(m._mesh, 0, np.array([vertex], np.int32), False)
-    ends = m.geometry.dofmap.links(c)[:2]
-    return c, int(np.flatnonzero(ends == node[0, 0])[0])
+    return c, int(np.flatnonzero(m.topology.connectivity(1, 0).links(c) == vertex)[0])
 
 
 def joint_density(disc, at):
-    """The DG_p Function ψ of the module doc for the named point ``at`` of the
+    """The values of ψ of the module doc at the DG_p nodes of each local cell, (n_cells,
+    p + 1), for the named point ``at`` of the
     :class:`~beamfx.analyses.discretisation.Discretisation` ``disc``: nonzero on one element
     next to the point (the one first in input order, so every rank picks the same).
 
     Raises:
         ValueError: if that element is curved or its nodes are not evenly spaced.
     """
-    from .discretisation import cell_field
-
     m, p = disc.mesh.mesh, disc.degree
     m.topology.create_connectivity(0, 1)
+    m.topology.create_connectivity(1, 0)
     n_cells = m.topology.index_map(1).size_local + m.topology.index_map(1).num_ghosts
     original = np.asarray(m.topology.original_cell_index)
     xi = np.r_[0.0, 1.0, np.arange(1, p) / p]  # basix order of the DG and geometry nodes
@@ -63,7 +60,7 @@ def joint_density(disc, at):
                 "element with evenly spaced nodes next to it"
             )
         values[c] = kernel(xi, end, p) / h
-    return cell_field(m, p, values)
+    return values
 
 
 __all__ = ["joint_density", "kernel"]
