@@ -251,3 +251,59 @@ def test_arclength_reactions_balance_along_the_path(tmp_path):
     assert len(path) == 7 and all("reactions" in p for p in path[1:])  # the start has none
     for r in run["reactions"].values():  # pinned about x: no moment about x
         assert abs(r["moment"][0]) < 1e-9 * np.abs(bal["applied_force"]).max()
+
+
+ROLLER = (
+    STEEL
+    + """
+[[beams]]
+name = "b"
+curve = { shape = "line", start = [0, 0, 0], end = [3, 0, 4] }
+section = { type = "rectangle", h = 0.1, w = 0.05 }
+elements = 4
+[[supports]]
+at = "b:start"
+fix = "pinned"
+[[supports]]
+at = "b:end"
+fix = ["uy", "uz"]
+axes = "local"
+[[springs]]
+at = "b:0.5"
+stiffness = [0, 2e5, 0]
+rotational = [1e3, 0, 0]
+[[loads]]
+at = "b:0.25"
+force = [1e3, 2e3, -3e3]
+[model]
+kinematics = "KIN"
+plane = "none"
+[analysis]
+type = "static"
+steps = 2
+"""
+)
+
+
+@pytest.mark.parametrize("kin", ["linear", "finite"])
+def test_local_roller_and_springs_react_with_their_spring_force(scene_file, tmp_path, kin):
+    """A support in local axes (stiff penalty springs normal to the member) and a spring to
+    ground react with their spring forces; with the pin they balance the load. The roller's
+    force is normal to the member (it slides along it). Tolerance: the roller's springs are
+    1e9 times stiffer than the beam, which raises the residual floor of the solve by about as
+    much (Newton stops there, at ~3e-7 of the load); the balance is as good as the final
+    residual |F| allows: Σ forces within a few |F|, Σ moments within a few |F| times the
+    member's length (5)."""
+    run, _ = _run(scene_file, tmp_path, ROLLER, KIN=kin)
+    reactions = run["reactions"]
+    assert set(reactions) == {"b:start", "b:end", "b:0.5"}
+    bal = run["reaction_balance"]
+    residual = max(run["load_steps"][-1]["residuals"][-1], 1e-12)
+    load = np.linalg.norm([1e3, 2e3, -3e3])  # the force scale; the moment scale is > 1.2 load
+    assert bal["force"] * load < 3 * residual
+    assert bal["moment"] * 1.2 * load < 3 * 5 * residual
+    roller = np.asarray(reactions["b:end"]["force"])
+    axis = np.array([3.0, 0, 4]) / 5
+    assert abs(roller @ axis) < 1e-6 * np.linalg.norm(roller) and np.linalg.norm(roller) > 100
+    spring = reactions["b:0.5"]
+    assert abs(spring["force"][1]) > 0 and spring["force"][0] == spring["force"][2] == 0
