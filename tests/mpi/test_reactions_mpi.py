@@ -90,3 +90,24 @@ def test_demo_frames_match_serial_and_the_exact_frame(name):
     for comm in (MPI.COMM_SELF, MPI.COMM_WORLD):
         u, reactions, _ = frame_peers.beamfx_frame(spec, comm)
         assert max(frame_peers.differences(u, reactions, exact, exact_r)) < 1e-8, comm.size
+
+
+def test_tower_scene_runs_on_two_ranks_with_the_reactions_of_one(tmp_path_factory):
+    """The whole ``beamfx run`` of the 96-member tower (probes, ParaView frames, results.json)
+    on all ranks and on one process: the same reactions and probes."""
+    from pathlib import Path
+
+    from beamfx.runner import run_scene
+
+    scene = Path(__file__).resolve().parents[2] / "demos" / "scenes" / "tower.toml"
+    comm = MPI.COMM_WORLD
+    base = Path(comm.bcast(str(tmp_path_factory.mktemp("tower")) if comm.rank == 0 else None))
+    parallel = run_scene(scene, base / "all", log=lambda m: None, comm=comm)
+    serial = run_scene(scene, base / f"one{comm.rank}", log=lambda m: None, comm=MPI.COMM_SELF)
+    for at, r in serial["reactions"].items():
+        for key in ("force", "moment"):
+            a, b = np.asarray(parallel["reactions"][at][key]), np.asarray(r[key])
+            assert np.allclose(a, b, rtol=1e-9, atol=1e-9 * 4e4), (at, key, a, b)
+    for name, p in serial["probes"].items():
+        a, b = parallel["probes"][name]["displacement"], p["displacement"]
+        assert np.allclose(a, b, rtol=1e-8, atol=1e-12), name
