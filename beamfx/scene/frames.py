@@ -66,14 +66,6 @@ def _groups(t, key, mesh_groups, kind):
     return name, mesh_groups[name]
 
 
-def _finite(t, key, default=None):
-    """A 3-vector of finite numbers (``default`` if absent)."""
-    value = t.get(key, "vec3", default)
-    if value is not None and not np.all(np.isfinite(value)):
-        t.fail(key, f"must be finite numbers, got {list(value)}")
-    return value
-
-
 def _members(frame, mesh, name, read_section):
     """Beams of the mesh's lines, with the section and orientation of their group."""
     section = [None] * len(mesh.members)
@@ -83,7 +75,7 @@ def _members(frame, mesh, name, read_section):
         s = read_section(t.table("section"))
         if getattr(s, "varies", False):  # values of s would mean nothing per member
             t.fail("section", "a frame member's section must be constant (numbers only)")
-        o, tw = _finite(t, "orientation"), t.get("twist_deg", float, 0.0)
+        o, tw = t.get("orientation", "vec3", None), t.get("twist_deg", float, 0.0)
         t.done()
         for m in idx:
             if section[m] is not None:
@@ -180,7 +172,7 @@ def _frame(frame, base, limits, read_section):
 
     def load(t, group, points):
         kind = t.get("kind", str, "dead", choices=LOAD_KINDS[:2])
-        f, m = _finite(t, "force", (0.0,) * 3), _finite(t, "moment", (0.0,) * 3)
+        f, m = t.get("force", "vec3", (0.0,) * 3), t.get("moment", "vec3", (0.0,) * 3)
         return [PointLoad(p, f, m, kind) for p in points]
 
     def probe(t, group, points):

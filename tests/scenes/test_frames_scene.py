@@ -127,11 +127,11 @@ def test_groups_the_mesh_lacks_and_members_without_section(tripod):
 
 def test_bad_values_name_their_key(tripod):
     text = SCENE.replace("force = [1e3, 2e3, -1e4]", "force = [nan, 0, 0]")
-    assert "frames[0].loads[0].force: must be finite numbers" in _error(tripod(text))
+    assert "frames[0].loads[0].force: expected a list of 3 finite numbers" in _error(tripod(text))
     text = SCENE.replace("section = { type", "orientation = [0.7, 0.7, 2.0]\nsection = { type")
     assert "frames[0].members[0].orientation" in _error(tripod(text))
     text = SCENE.replace("elements = 2", "elements = 0")
-    assert "frames[0].elements: must be positive" in _error(tripod(text))
+    assert "frames[0].elements = 0: must be > 0" in _error(tripod(text))
     text = SCENE.replace('group = "apex"\nforce', 'group = "apex"\nforce_per_length')
     assert "frames[0].loads[0]" in _error(tripod(text))
 
@@ -140,3 +140,12 @@ def test_a_follower_load_at_a_joint_of_three_members_is_refused(tripod, tmp_path
     text = SCENE.replace("KIN", "finite").replace("force = [1e3", 'kind = "follower"\nforce = [1e3')
     with pytest.raises(ValueError, match="joins 3 elements: only dead forces"):
         run_scene(tripod(text), tmp_path / "out", log=lambda m: None)
+
+
+def test_limits_and_repeated_members(tripod, tmp_path):
+    """[limits] max_beams bounds the members; a member given twice (reversed) is refused."""
+    text = "[limits]\nmax_beams = 2\n" + SCENE
+    assert "frames[0].mesh: 3 members; allowed: at most 2" in _error(tripod(text))
+    write_line_mesh(tmp_path / "tripod.msh", POINTS, [*MEMBERS, [3, 0]], {"legs": [0, 1, 2, 3]}, {})
+    message = _error(tmp_path / "scene.toml")
+    assert "tripod.msh: nodes [3, 0] are joined by two members" in message
