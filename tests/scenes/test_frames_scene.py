@@ -149,3 +149,17 @@ def test_limits_and_repeated_members(tripod, tmp_path):
     write_line_mesh(tmp_path / "tripod.msh", POINTS, [*MEMBERS, [3, 0]], {"legs": [0, 1, 2, 3]}, {})
     message = _error(tmp_path / "scene.toml")
     assert "tripod.msh: nodes [3, 0] are joined by two members" in message
+
+
+def test_closest_point_of_a_line_is_the_clipped_projection():
+    """The closed form for straight members (the frame checks call it for every end near a
+    member) against the sampled search it replaces for lines."""
+    from beamfx.analyses.checks import closest_arc_length
+    from beamfx.geometry.curves import Line, Polyline
+
+    line = Line((0.0, 1.0, 0.0), (3.0, 5.0, 0.0))
+    same = Polyline(((0.0, 1.0, 0.0), (3.0, 5.0, 0.0)))  # no closed form: sampled
+    for x in ([1.0, 2.0, 1.0], [-2.0, 0.0, 0.0], [4.0, 7.0, -1.0], [1.5, 3.0, 0.0]):
+        s, d = closest_arc_length(line, np.array(x))
+        s_ref, d_ref = closest_arc_length(same, np.array(x))
+        assert s == pytest.approx(s_ref, abs=1e-9) and d == pytest.approx(d_ref, abs=1e-9)
