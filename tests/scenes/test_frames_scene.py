@@ -153,7 +153,8 @@ def test_limits_and_repeated_members(tripod, tmp_path):
 
 def test_closest_point_of_a_line_is_the_clipped_projection():
     """The closed form for straight members (the frame checks call it for every end near a
-    member) against the sampled search it replaces for lines."""
+    member) against the sampled search it replaces for lines; that search finds s only to
+    about sqrt(ε) of the length (the distance is flat at its minimum), d to round-off."""
     from beamfx.analyses.checks import closest_arc_length
     from beamfx.geometry.curves import Line, Polyline
 
@@ -162,4 +163,4 @@ def test_closest_point_of_a_line_is_the_clipped_projection():
     for x in ([1.0, 2.0, 1.0], [-2.0, 0.0, 0.0], [4.0, 7.0, -1.0], [1.5, 3.0, 0.0]):
         s, d = closest_arc_length(line, np.array(x))
         s_ref, d_ref = closest_arc_length(same, np.array(x))
-        assert s == pytest.approx(s_ref, abs=1e-9) and d == pytest.approx(d_ref, abs=1e-9)
+        assert s == pytest.approx(s_ref, abs=1e-7) and d == pytest.approx(d_ref, abs=1e-12)
