@@ -23,6 +23,7 @@ class LineMesh(NamedTuple):
     members: np.ndarray  # (m, 2) node indices of each member, in file order, no duplicates
     member_groups: dict  # {group name: member indices}
     node_groups: dict  # {group name: node indices}
+    curves: tuple = ()  # per member: None (straight) or (k, 3) points along it (a .geo curve)
 
 
 def _group_names(field_data):
@@ -50,12 +51,15 @@ def _blocks(mesh, path):
 
 
 def read_line_mesh(path):
-    """The :class:`LineMesh` of the mesh file at ``path``.
+    """The :class:`LineMesh` of the file at ``path``: a gmsh ``.msh`` mesh (each line element
+    a straight member) or a gmsh ``.geo`` geometry (:func:`read_geo_frame`).
 
     Raises:
         ValueError: naming the file, if it does not parse, holds no line element, has
             non-finite coordinates or zero-length members.
     """
+    if str(path).lower().endswith(".geo"):
+        return read_geo_frame(path)
     import meshio.gmsh
 
     try:  # the format's reader itself: meshio.read would print and sys.exit on a bad file
@@ -96,6 +100,54 @@ def read_line_mesh(path):
     )
 
 
+def read_geo_frame(path, samples=201):
+    """The :class:`LineMesh` of a gmsh ``.geo`` file (read by
+    :func:`~beamfx.geometry.curves.read_gmsh`, no meshing): each curve (1D entity) is one
+    member between its two end points, straight or curved (then sampled along gmsh's
+    parametrisation); physical groups of curves and points name member and node groups."""
+    from .curves import read_gmsh
+
+    return read_gmsh(path, lambda gmsh: _geo_frame(gmsh, str(path), samples))
+
+
+def _geo_frame(gmsh, path, samples):
+    """:func:`read_geo_frame` on the open gmsh model."""
+    nodes, points, members, curves, index = {}, [], [], [], {}
+
+    def node(tag):
+        if tag not in nodes:
+            nodes[tag] = len(points)
+            points.append(np.reshape(gmsh.model.getValue(0, tag, []), 3))
+        return nodes[tag]
+
+    for _, tag in gmsh.model.getEntities(1):
+        ends = [t for _, t in gmsh.model.getBoundary([(1, tag)], combined=False, oriented=False)]
+        if len(ends) != 2 or ends[0] == ends[1]:
+            raise ValueError(f"{path}: curve {tag} is closed; split it into members with two ends")
+        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+        xyz = np.reshape(gmsh.model.getValue(1, tag, np.linspace(lo[0], hi[0], samples)), (-1, 3))
+        a, b = node(ends[0]), node(ends[1])
+        if np.linalg.norm(xyz[0] - points[a]) > np.linalg.norm(xyz[0] - points[b]):
+            a, b = b, a  # members run along the parametrisation
+        chord = xyz[-1] - xyz[0]
+        off = np.cross(xyz - xyz[0], chord / max(np.linalg.norm(chord), 1e-300))
+        straight = np.abs(off).max() <= 1e-9 * np.linalg.norm(chord)
+        index[tag] = len(members)
+        members.append((a, b))
+        curves.append(None if straight else xyz)
+    if not members:
+        raise ValueError(f"{path}: no curves (members) in the file")
+    groups = {1: {}, 0: {}}
+    for dim, ptag in gmsh.model.getPhysicalGroups():
+        name = gmsh.model.getPhysicalName(dim, ptag) or str(ptag)
+        tags = gmsh.model.getEntitiesForPhysicalGroup(dim, ptag)
+        if dim in groups:
+            ids = [index[t] for t in tags] if dim == 1 else [node(t) for t in tags]
+            groups[dim][name] = np.unique(np.asarray(ids, np.int64))
+    lines = np.array(members, np.int64)
+    return LineMesh(np.array(points), lines, groups[1], groups[0], tuple(curves))
+
+
 def write_line_mesh(path, points, members, member_groups, node_groups):
     """Write a gmsh 2.2 ASCII ``.msh`` with the groups as physical groups (the examples in
     meshes/ are made with it): ``member_groups`` {name: member indices}, ``node_groups``
@@ -129,4 +181,4 @@ def write_line_mesh(path, points, members, member_groups, node_groups):
     meshio.write(str(path), mesh, file_format="gmsh22", binary=False)
 
 
-__all__ = ["LineMesh", "read_line_mesh", "write_line_mesh"]
+__all__ = ["LineMesh", "read_geo_frame", "read_line_mesh", "write_line_mesh"]

@@ -1,16 +1,17 @@
 """``[[frames]]``: frames (towers, domes, lattices) read from a line mesh file whose groups
 name the sections, orientations, supports, loads and probes.
 
-Each two-node line of the mesh becomes a straight beam ``<name>.<k>`` (k = 1, 2, ... in file
-order) with the frame's ``elements`` and ``degree``; members meet at shared nodes, where the
-joint is rigid (displacement and rotation are continuous fields). A node group names points:
-each of its nodes becomes the end of one member meeting there, so supports, point loads and
-probes of a group are ordinary ``[[supports]]``, ``[[loads]]`` and ``[[probes]]`` entries of
+Each two-node line of a ``.msh`` mesh, and each curve (straight or curved) of a ``.geo``
+geometry, becomes a beam ``<name>.<k>`` (k = 1, 2, ... in file order) with the frame's
+``elements`` and ``degree``; members meet at shared nodes, where the joint is rigid
+(displacement and rotation are continuous fields). A node group names points: each of its
+nodes becomes the end of one member meeting there, so supports, point loads and probes of a
+group are ordinary ``[[supports]]``, ``[[loads]]`` and ``[[probes]]`` entries of
 the model. Example (docs/scenes.md, "Frames from mesh files")::
 
     [[frames]]
     name = "tower"
-    mesh = "tower.msh"        # gmsh .msh (physical groups), beside the scene file
+    mesh = "tower.msh"        # gmsh .msh or .geo (physical groups), beside the scene file
     elements = 2              # per member
     degree = 2
     [[frames.members]]
@@ -31,14 +32,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..geometry.curves import Line
+from ..geometry.curves import Line, SampledCurve
 from ..spec import LOAD_KINDS, Beam, PointLoad, Support
 from .files import named_file
 from .limits import unknowns
 from .loads import read_fix
 from .table import SceneError, Table
 
-MESH_SUFFIXES = (".msh",)
+MESH_SUFFIXES = (".msh", ".geo")
 
 
 class FrameParts(NamedTuple):
@@ -104,6 +105,17 @@ def _check_orientation(t, mesh, m, o):
         t.fail("orientation", f"{list(o)} is parallel to member {m + 1}; give a normal vector")
 
 
+def _member_curve(mesh, k):
+    """Member ``k``: a :class:`Line` between its nodes, or the curve through the points of a
+    curved member of a ``.geo`` file (its ends at the nodes)."""
+    a, b = mesh.points[mesh.members[k]]
+    if not mesh.curves or mesh.curves[k] is None:
+        return Line(tuple(a), tuple(b))
+    xyz = np.array(mesh.curves[k])
+    xyz[0], xyz[-1] = a, b
+    return SampledCurve(tuple(map(tuple, xyz)))
+
+
 def _node_points(mesh, name):
     """The point name ``<name>.<k>:start|end`` of each node: the first member meeting there."""
     at = {}
@@ -156,7 +168,7 @@ def _frame(frame, base, limits, read_section):
     beams = [
         Beam(
             f"{name}.{k + 1}",
-            Line(*map(tuple, mesh.points[m])),
+            _member_curve(mesh, k),
             section[k],
             elements,
             degree,

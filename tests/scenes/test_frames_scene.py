@@ -164,3 +164,50 @@ def test_closest_point_of_a_line_is_the_clipped_projection():
         s, d = closest_arc_length(line, np.array(x))
         s_ref, d_ref = closest_arc_length(same, np.array(x))
         assert s == pytest.approx(s_ref, abs=1e-7) and d == pytest.approx(d_ref, abs=1e-12)
+
+
+TRIPOD_GEO = """// tripod.geo: the tripod's three legs, and an arched fourth member from the apex
+Point(1) = {0, 0, 0};
+Point(2) = {2, 0, 0};
+Point(3) = {0, 2, 0};
+Point(4) = {0.7, 0.7, 2};
+Line(1) = {1, 4};
+Line(2) = {2, 4};
+Line(3) = {3, 4};
+Physical Curve("legs") = {1, 2, 3};
+Physical Point("feet") = {1, 2, 3};
+Physical Point("apex") = {4};
+"""
+
+
+def test_a_geo_frame_equals_the_msh_frame(tripod, tmp_path):
+    """The same tripod from a .geo file (gmsh geometry, scanned and read by
+    geometry.curves.read_gmsh) gives the same members, groups and reactions."""
+    path = tripod(SCENE.replace("KIN", "linear"))
+    msh = run_scene(path, tmp_path / "msh", log=lambda m: None)
+    (tmp_path / "tripod.geo").write_text(TRIPOD_GEO)
+    (tmp_path / "scene.toml").write_text(path.read_text().replace("tripod.msh", "tripod.geo"))
+    geo = run_scene(tmp_path / "scene.toml", tmp_path / "geo", log=lambda m: None)
+    for at, r in msh["reactions"].items():
+        assert np.allclose(geo["reactions"][at]["force"], r["force"], rtol=1e-12, atol=1e-9)
+
+
+def test_curved_geo_members_follow_the_gmsh_curve(tmp_path):
+    """A portal whose girder is a circular arc (gmsh Circle): the member is the arc (its
+    length), and the reactions balance the weight."""
+    (tmp_path / "arch.geo").write_text(
+        "Point(1) = {0, 0, 0};\nPoint(2) = {0, 0, 2};\nPoint(3) = {2, 0, 2};\n"
+        "Point(4) = {4, 0, 2};\nPoint(5) = {4, 0, 0};\n"
+        "Line(1) = {1, 2};\nCircle(2) = {2, 3, 4};\nLine(3) = {4, 5};\n"
+        'Physical Curve("all") = {1, 2, 3};\nPhysical Point("feet") = {1, 5};\n'
+    )
+    text = SCENE.replace("KIN", "linear").replace("tripod.msh", "arch.geo")
+    text = text.replace('"legs"', '"all"').replace('group = "apex"\nforce = [1e3, 2e3, -1e4]\n', "")
+    text = text.replace("[[frames.loads]]\n", "").replace('[[frames.probes]]\ngroup = "apex"\n', "")
+    (tmp_path / "scene.toml").write_text(text)
+    from beamfx.scene import load_scene
+
+    beams = load_scene(tmp_path / "scene.toml").model.beams
+    assert beams[1].curve.length == pytest.approx(np.pi * 2, rel=1e-8)
+    run = run_scene(tmp_path / "scene.toml", tmp_path / "out", log=lambda m: None)
+    assert run["reaction_balance"]["force"] < 1e-9
