@@ -1,5 +1,5 @@
 """Write the frame meshes of demos/scenes/ (beside their scenes: a scene names files inside its
-folder): a space-truss tower and a lattice dome (gmsh 2.2 .msh
+folder): a space-truss tower, a lattice dome and a BCC lattice block (gmsh 2.2 .msh
 with physical groups naming member and node groups). Run from the repository root:
 ``python scripts/make_frame_meshes.py``; the files are committed, so this only documents and
 reproduces them."""
@@ -79,8 +79,39 @@ def dome(meridians=12, rings=4, radius=10.0, rise=4.0):
     return np.array(points), members, groups, nodes
 
 
+def lattice(cells=3, size=0.01):
+    """A body-centred cubic lattice block of ``cells``³ cells of edge ``size``: the cube
+    edges, and in every cell the eight half-diagonals from the corners to a centre node."""
+    n = cells + 1
+    grid = np.array([[i, j, k] for k in range(n) for j in range(n) for i in range(n)], float)
+    centres = np.array(
+        [[i, j, k] for k in range(cells) for j in range(cells) for i in range(cells)], float
+    )
+    points = np.vstack([grid, centres + 0.5]) * size
+
+    def node(i, j, k):
+        return i + n * (j + n * k)
+
+    edges, struts = [], []
+    for i, j, k in grid.astype(int):
+        for d in np.eye(3, dtype=int):
+            a, b, c = i + d[0], j + d[1], k + d[2]
+            if max(a, b, c) < n:
+                edges.append((node(i, j, k), node(a, b, c)))
+    for m, (i, j, k) in enumerate(centres.astype(int)):
+        for corner in np.ndindex(2, 2, 2):
+            struts.append((node(i + corner[0], j + corner[1], k + corner[2]), len(grid) + m))
+    members = edges + struts
+    groups = {"edges": range(len(edges)), "struts": range(len(edges), len(members))}
+    nodes = {
+        "bottom": [node(i, j, 0) for j in range(n) for i in range(n)],
+        "top": [node(i, j, cells) for j in range(n) for i in range(n)],
+    }
+    return points, members, groups, nodes
+
+
 def main():
-    for name, build in (("tower", tower), ("dome", dome)):
+    for name, build in (("tower", tower), ("dome", dome), ("lattice", lattice)):
         points, members, groups, nodes = build()
         write_line_mesh(SCENES / f"{name}.msh", points, members, groups, nodes)
         print(f"demos/scenes/{name}.msh: {len(points)} nodes, {len(members)} members")

@@ -6,7 +6,7 @@ Run by ``make bench-peers``::
     .venv-peers/bin/python peers/opensees_frame.py DIR  # DIR/opensees_frame.json
     python -m beamfx.bench.frame_peers DIR           # compare; DIR/frame_compare.json
 
-The problems are the demo frames (demos/scenes/tower.toml, dome.toml) with linear kinematics,
+The problems are the demo frames (demos/scenes/tower.toml, dome.toml, lattice.toml) with linear kinematics,
 P3 elements and their joint loads only (no gravity: a load along a member is not a joint
 load, which the exact frame solution :mod:`~beamfx.bench.frame_stiffness` and OpenSees'
 nodal loads would need as equivalent nodal loads). Errors are max |difference| / max |value|
@@ -24,7 +24,7 @@ import numpy as np
 from . import frame_stiffness
 
 DEMOS = Path(__file__).resolve().parents[2] / "demos" / "scenes"
-FRAMES = ("tower", "dome")
+FRAMES = ("tower", "dome", "lattice")
 
 
 def linear_frame(spec, degree=3):

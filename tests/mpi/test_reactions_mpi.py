@@ -75,7 +75,7 @@ def test_frame_reactions_match_serial(kin):
         assert result["reaction_balance"]["moment"] < 1e-9
 
 
-@pytest.mark.parametrize("name", ["tower", "dome"])
+@pytest.mark.parametrize("name", ["tower", "dome", "lattice"])
 def test_demo_frames_match_serial_and_the_exact_frame(name):
     """The demo frames, linear: point loads at joints of many elements (the joint density
     on an element that may sit on either rank) and the reactions of 4 or 12 supports."""

@@ -85,7 +85,7 @@ def test_tripod_runs_and_its_reactions_balance_the_loads(tripod, tmp_path, kin):
     assert "apex" in run["probes"]
 
 
-@pytest.mark.parametrize("name", ["tower", "dome"])
+@pytest.mark.parametrize("name", ["tower", "dome", "lattice"])
 def test_demo_frames_run_and_balance(name, tmp_path):
     run = run_scene(DEMOS / f"{name}.toml", tmp_path / "out", log=lambda m: None)
     assert run.converged
