@@ -46,6 +46,9 @@ bench-peers: install
 	.venv-peers/bin/python peers/elastica_cases.py $(PEERS)
 	.venv-peers/bin/python peers/calculix_cases.py $(PEERS)
 	$(PY) -m beamfx.bench.peers $(PEERS) docs/validation
+	$(PY) -m beamfx.bench.frame_peers export $(PEERS)
+	.venv-peers/bin/python peers/opensees_frame.py $(PEERS)
+	$(PY) -m beamfx.bench.frame_peers $(PEERS)
 
 lint: install
 	$(VENV)/bin/ruff check .

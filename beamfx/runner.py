@@ -37,6 +37,7 @@ class RunResult:
     paraview: dict  # the files written for ParaView
     accuracy: dict | None = None  # the [accuracy] refinement, if asked
     pictures: dict | None = None  # the pictures rendered, if asked
+    reactions: dict | None = None  # reactions and their balance (static and arc length)
 
     @property
     def converged(self) -> bool:
@@ -48,6 +49,8 @@ class RunResult:
         out = {"scene": self.scene, **self.result.to_json(), "model": self.model}
         if self.accuracy is not None:
             out["accuracy"] = self.accuracy
+        if self.reactions is not None:
+            out.update(self.reactions)
         out.update(wall_time_s=self.wall_time_s, probes=self.probes, paraview=self.paraview)
         if self.pictures is not None:
             out["pictures"] = self.pictures
@@ -117,6 +120,7 @@ def run_scene(
             {**result.seconds, "run": time.perf_counter() - t_start},
             ctx.frames.files(),
             refinement.entry(scene.accuracy) if refinement else None,
+            reactions=_reactions(ctx),
         )
         return _finish(run, out, scene, refinement, log, comm, png, animate)
 
@@ -244,6 +248,16 @@ def _model_entry(scene, ctx):
         "trimming": _trimming(scene, model)[1],
         "condensed": bool(scene.condense and ctx.rebuild is not None),
     }
+
+
+def _reactions(ctx):
+    """The reactions of the analysis's last accepted state, logged with their balance."""
+    if ctx.latest_reactions is None:
+        return None
+    from .analyses.reactions import balance_line
+
+    ctx.log(balance_line(ctx.latest_reactions))
+    return ctx.latest_reactions
 
 
 def _final_probes(scene, ctx):

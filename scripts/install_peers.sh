@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${PEERS_VENV:-.venv-peers}
-PKGS=(exudyn pyelastica numpy matplotlib)
+PKGS=(exudyn pyelastica numpy matplotlib "openseespy==3.8.0.0")
 
 # CalculiX (Debian `calculix-ccx`, binary `ccx`): checked before the fast path below
 if ! command -v ccx >/dev/null 2>&1; then
@@ -21,13 +21,13 @@ fi
 if [ ! -x "$VENV/bin/python" ]; then
   /usr/bin/python3 -m venv "$VENV"
 fi
-if "$VENV/bin/python" -c "import exudyn, elastica, numpy, matplotlib" 2>/dev/null; then
+if "$VENV/bin/python" -c "import exudyn, elastica, numpy, matplotlib, openseespy.opensees" 2>/dev/null; then
   exit 0
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 "$VENV/bin/python" -m pip install --quiet "${PKGS[@]}"
 "$VENV/bin/python" - <<'PY'
-import exudyn, elastica, numpy
+import exudyn, elastica, numpy, openseespy.opensees
 print("peers: exudyn", exudyn.__version__, "| pyelastica", getattr(elastica, "__version__", "?"),
-      "| numpy", numpy.__version__)
+      "| openseespy", getattr(openseespy.opensees, "version", lambda: "?")(), "| numpy", numpy.__version__)
 PY

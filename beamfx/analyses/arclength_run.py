@@ -129,11 +129,12 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     from ..solvers.arclength import ArcLengthSettings
     from .continuation import limit_points, trace_path
 
-    record, count = _csv_writer(ctx), [0]
+    record, count, reactions = _csv_writer(ctx), [0], []
 
     def on_step(point):
         record(count[0], point)
         ctx.step(model, count[0], point.load_factor)
+        reactions.append(ctx.latest_reactions["reactions"])
         count[0] += 1
 
     keys = ("control_point", "max_steps", "target_load_factor", "arc_length")
@@ -158,8 +159,9 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
             "arc_length": p.arc_length,
             "negative_eigenvalues": p.negative_eigenvalues,
             **({"note": p.note} if p.note else {}),
+            **({"reactions": r} if r is not None else {}),
         }
-        for p in result.path
+        for p, r in zip(result.path, [None] * (len(result.path) - len(reactions)) + reactions)
     ]
     found = limit_points(result.path)
     limits = [

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..geometry.curves import Line
 from ..geometry.frames import section_axes_at
 from ..spec import DOF_NAMES, resolve_point
 from .dofs import OUT_OF_PLANE
@@ -29,6 +30,11 @@ def model_size(model):
 
 def closest_arc_length(curve, x, samples=400):
     """Arc length of the point of ``curve`` closest to ``x``, and the distance."""
+    if isinstance(curve, Line):  # closed form: the projection, clipped to the segment
+        start, L = np.asarray(curve.start, float), curve.length
+        d = (np.asarray(curve.end, float) - start) / L
+        s = float(np.clip((np.asarray(x, float) - start) @ d, 0.0, L))
+        return s, float(np.linalg.norm(start + s * d - x))
     a, b, n = 0.0, curve.length, samples
     for _ in range(8):  # sample, bracket the nearest sample, refine: 16x narrower per pass
         s = np.linspace(a, b, n + 1)

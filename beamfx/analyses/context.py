@@ -41,6 +41,16 @@ class RunContext:
     rebuild: Callable | None = None
     latest: dict | None = None  # probe values of the last accepted state, tracked
     _points: list | None = field(default=None, init=False, repr=False)  # the probes' points
+    latest_reactions: dict | None = None  # results.json entries of the last reactions
+
+    def reactions(self, model):
+        """Support reactions and their balance with the loads at the model's current state
+        (collective), as results.json entries (:func:`beamfx.analyses.reactions.entries`);
+        kept as :attr:`latest_reactions`."""
+        from .reactions import entries
+
+        self.latest_reactions = entries(model)
+        return self.latest_reactions
 
     def probe_values(self, model, track=True, full=True):
         """Probe values of the model's current state (collective): ``{point: values}``, the
@@ -58,6 +68,7 @@ class RunContext:
     def step(self, model, step, time):
         """After an accepted step: probes tracked, and a frame where the output asks."""
         self.probe_values(model)
+        self.reactions(model)
         if self.frames.want(step, time):
             self.frames.write(step, time)
 
@@ -82,7 +93,7 @@ class RunContext:
     def fallback(self):
         """The full model instead of the condensed one: the failed attempt's probes and frames
         are forgotten, and the new model is returned (and kept as :attr:`model`)."""
-        self.latest = None
+        self.latest = self.latest_reactions = None
         self.frames.resume(0.0)
         self.model, self.rebuild = self.rebuild(), None
         self.frames.follow(self.model)

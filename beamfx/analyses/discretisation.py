@@ -277,23 +277,38 @@ class Discretisation:
         Raises:
             ValueError: if more than two elements meet at the point.
         """
-        tag = self.mesh.points[at][0]
-        m = self.mesh.mesh
-        m.topology.create_connectivity(0, 1)
-        c = m.topology.connectivity(0, 1)
-        vertices = self.mesh.point_tags.find(tag)
-        n_local = max([len(c.links(v)) for v in vertices], default=0)
-        if self.comm.allreduce(n_local, op=MPI.MAX) > 2:
+        tag, m = self.mesh.points[at][0], self.mesh.mesh
+        n = self.elements_at(at)
+        if n > 2:
             raise ValueError(
-                f"{at!r} joins more than two elements: loads and springs there are not supported"
+                f"{at!r} joins {n} elements: only dead forces (and moments of linear or planar "
+                "kinematics) can act there, no springs, masses or other loads"
             )
-        inner = self.comm.allreduce(n_local, op=MPI.MAX) == 2
-        if inner:
+        if n == 2:
             return ufl.dS(domain=m, subdomain_data=self.mesh.point_tags)(tag), "+"
         return ufl.ds(domain=m, subdomain_data=self.mesh.point_tags)(tag), None
 
-    def at_point(self, at, integrand):
-        """``integrand`` integrated at the named point (restricted there if it is inside)."""
+    def elements_at(self, at):
+        """Number of elements that meet at the named point ``at`` (all ranks). Collective."""
+        m = self.mesh.mesh
+        m.topology.create_connectivity(0, 1)
+        c = m.topology.connectivity(0, 1)
+        vertices = self.mesh.point_tags.find(self.mesh.points[at][0])
+        return self.comm.allreduce(max([len(c.links(v)) for v in vertices], default=0), MPI.MAX)
+
+    def at_point(self, at, integrand, cell_exact=False):
+        """``integrand`` integrated at the named point (restricted there if it is inside).
+
+        ``cell_exact``: the integrand is linear in the test function with coefficients that
+        are constant on a cell (a dead force); where more than two elements meet (a joint of a
+        frame, where no facet measure reaches) it is then integrated exactly on one of them,
+        weighted by the density of :func:`~beamfx.analyses.joints.joint_density`.
+        """
+        if cell_exact and self.elements_at(at) > 2:
+            from .joints import joint_density
+
+            psi = cell_field(self.mesh.mesh, self.degree, joint_density(self, at))
+            return integrand * psi * self.dx
         dP, side = self.point_measure(at)
         return (integrand(side) if side else integrand) * dP
 

@@ -88,6 +88,10 @@ class BeamFormulation(Formulation, Protocol):
 
     Pi: object
     """UFL internal energy (strain energy, springs, penalties) of ``w``."""
+    Pi_ground: object
+    """UFL energy of the springs to ground and of the supports in local axes (stiff penalty
+    springs), part of ``Pi``; None if there are none. Their forces are support reactions
+    (:mod:`beamfx.analyses.reactions`)."""
     k_penalty: object
     """``fem.Constant`` of the quaternion unit-norm penalty (part of ``Pi`` for finite
     spatial kinematics)."""

@@ -82,15 +82,19 @@ class BeamModel(Discretised):
         Pi = d.strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, d.dx)
+        ground = 0  # springs to ground and local-axes supports: their forces are reactions
         for sp in spec.springs:
             k_u, k_r = [float(k) for k in sp.stiffness], [float(k) for k in sp.rotational]
             if any(k_u):
-                Pi += d.at_point(sp.at, energy.spring_energy(u3, k_u))
+                ground += d.at_point(sp.at, energy.spring_energy(u3, k_u))
             if any(k_r):
-                Pi += d.at_point(sp.at, energy.rotational_spring_energy(kin, rot, k_r))
+                ground += d.at_point(sp.at, energy.rotational_spring_energy(kin, rot, k_r))
         for sup in spec.supports:
             if sup.axes == "local":
-                Pi += d.at_point(sup.at, self._local_support_penalty(sup, u3, rot))
+                ground += d.at_point(sup.at, self._local_support_penalty(sup, u3, rot))
+        self.Pi_ground = None if isinstance(ground, int) else ground
+        if self.Pi_ground is not None:
+            Pi += ground
 
         def vec(x):
             return ufl.as_vector([float(c) for c in x])
@@ -102,8 +106,9 @@ class BeamModel(Discretised):
             return energy.load_work(kin, rot, v_u, v_rot, force, moment, load.kind, load.arm)
 
         work = 0
-        for ld in spec.point_loads:
-            work += self._history_factor(ld) * d.at_point(ld.at, work_of(ld))
+        for ld in spec.point_loads:  # constant on a cell: dead forces, moments if θ is linear
+            exact = ld.kind == "dead" and not (kin.finite and not kin.plane and any(ld.moment))
+            work += self._history_factor(ld) * d.at_point(ld.at, work_of(ld), exact)
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
             on_beam = 1.0 if dl.beam is None else d.beam_indicator(names.index(dl.beam))

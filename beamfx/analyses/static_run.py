@@ -40,7 +40,8 @@ def solve(model: Formulation, settings: Settings, ctx: RunContext) -> tuple["Sta
     def on_step(step):
         ctx.step(model, step.step, step.load_factor)
         values = {name: ctx.latest[at] for name, at in ctx.probes.items()}
-        path.append({"load_factor": step.load_factor, "probes": values})
+        reactions = ctx.latest_reactions["reactions"]
+        path.append({"load_factor": step.load_factor, "probes": values, "reactions": reactions})
 
     opts = ctx.solver_options
     solved = solve_static(model, steps=settings.steps, options=opts, on_step=on_step, log=ctx.log)

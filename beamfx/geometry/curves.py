@@ -216,12 +216,24 @@ def curve_from_gmsh(path, curve_tag=None, samples=400):
     """The curve of a gmsh ``.geo`` or ``.msh`` file, as a :class:`SampledCurve`.
 
     With several curves, ``curve_tag`` picks one; consecutive curves of a ``.geo`` are not
-    joined: describe each as its own beam sharing end points. A ``.geo`` file is scanned first
+    joined: describe each as its own beam sharing end points. The file is read by
+    :func:`read_gmsh` (a ``.geo`` scanned first).
+
+    Raises:
+        ValueError: naming the file, for a refused or unreadable file.
+    """
+    xyz = read_gmsh(path, lambda gmsh: _gmsh_curve_points(gmsh, str(path), curve_tag, samples))
+    return SampledCurve(tuple(map(tuple, xyz)))
+
+
+def read_gmsh(path, read):
+    """``read(gmsh)`` with the gmsh file at ``path`` open, and its result: the one way beamfx
+    opens gmsh files. A ``.geo`` file is scanned first
     (:func:`~beamfx.geometry.geo_scan.check_geo`: plain geometry only, nothing that runs,
     writes, reads or loops); gmsh reads no configuration file and writes no preference file.
 
     Raises:
-        ValueError: naming the file, for a refused or unreadable file.
+        ValueError: naming the file, for a refused or unreadable file (gmsh's errors too).
     """
     import gmsh
 
@@ -237,14 +249,13 @@ def curve_from_gmsh(path, curve_tag=None, samples=400):
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setString("General.TmpFileName", "")  # nothing to remove in the home folder
         gmsh.open(path)
-        xyz = _gmsh_curve_points(gmsh, path, curve_tag, samples)
+        return read(gmsh)
     except Exception as e:  # gmsh raises a bare Exception with its last error message
         if isinstance(e, ValueError):
             raise
         raise ValueError(f"{path}: gmsh could not read it: {e}") from None
     finally:
         gmsh.finalize()
-    return SampledCurve(tuple(map(tuple, xyz)))
 
 
 def _gmsh_curve_points(gmsh, path, curve_tag, samples):

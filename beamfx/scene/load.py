@@ -6,6 +6,7 @@ The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, `
 
 import os
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ from ..solvers.options import option_problems
 from ..spec import Beam, Model
 from .curve import overlap, read_curve
 from .files import read_toml
+from .frames import read_frames
 from .limits import read_limits, unknowns
 from .loads import read_loads, read_masses, read_springs, read_supports
 from .section import read_material, read_section
@@ -67,6 +69,9 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     beams = _beams(top, mat, base, limits)
     supports = read_supports(top)
     point_loads, distributed, gravity = read_loads(top)
+    frames = read_frames(top, base, limits, partial(read_section, mat=mat, length=1.0), beams)
+    beams, supports = beams + frames.beams, supports + frames.supports
+    point_loads += frames.point_loads
     springs = read_springs(top)
     masses = read_masses(top)
     plane, condense, kin = _model_table(top.table("model", {}))
@@ -76,6 +81,9 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
 
     probes = _probes(top)
+    for name in set(probes) & set(frames.probes):
+        top.fail("probes", f"probe {name!r} is given twice ([[probes]] and [[frames.probes]])")
+    probes.update(frames.probes)
     output = _output(top.table("output", {}), limits)
     solver = top.get("solver", dict, {})
     for key, message in option_problems(solver):  # an allow-list: no viewers, logs, files
@@ -185,8 +193,10 @@ def _beams(top, mat, base, limits):
             )
         )
         t.done()
-    if not beams:
+    if not beams and not top.has("frames"):
         top.fail("beams", "a scene needs at least one [[beams]] table")
+    if not beams:
+        return beams
     _check_size(top, beams, limits)
     for i, b in enumerate(beams):
         _check_orientation(b, top.where(f"beams[{i}].orientation"))

@@ -116,6 +116,9 @@ def _fix(t):
     return tuple(fix)
 
 
+read_fix = _fix  # ``fix`` of a table: also [[frames.supports]] (beamfx.scene.frames)
+
+
 def read_supports(top):
     """``[[supports]]``: fixed dofs, prescribed motion."""
     supports = []
@@ -213,4 +216,4 @@ def read_masses(top):
     return masses
 
 
-__all__ = ["FIX_WORDS", "read_loads", "read_masses", "read_springs", "read_supports"]
+__all__ = ["FIX_WORDS", "read_fix", "read_loads", "read_masses", "read_springs", "read_supports"]

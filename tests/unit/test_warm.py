@@ -73,7 +73,9 @@ def test_markdown_toml_blocks_become_scene_files_beside_the_geo_blocks(tmp_path)
 
 def test_folders_give_their_toml_files():
     sources = scene_sources([ROOT / "demos" / "scenes"], None)
-    assert {s.path.name for s in sources} == {"prestress_sweep.toml", "spin_up.toml"}
+    names = {s.path.name for s in sources}
+    frames = {"dome.toml", "lattice.toml", "tower.toml"}
+    assert names == {"prestress_sweep.toml", "spin_up.toml"} | frames
 
 
 def test_shortened_cuts_only_the_time_loop(tmp_path):

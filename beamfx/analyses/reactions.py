@@ -1,0 +1,286 @@
+r"""Support reactions: the force and moment that each support (and spring to ground) exerts
+on the structure, in global axes, and their balance with the applied loads.
+
+**From the residual, not from the section resultants.** At equilibrium the assembled residual
+F = F_int − λ f_ext vanishes at the free dofs; at a dof held by a Dirichlet condition it is the
+force that holds it, r = F_int − λ f_ext (the solvers replace those rows, so it is assembled
+here without the conditions). The discrete rigid-body motions lie in the finite-element space
+(isoparametric geometry, the quaternion map q ↦ ½ (0, ω) ⊗ q is linear in q) and leave the
+strain energy and the quaternion penalty unchanged, so F_int · Φ_rigid = 0 holds to round-off:
+the reactions balance the loads as exactly as Newton converged. The stress resultants N, M at
+an end section would not: they are recovered from Gauss points, miss the loads on the end
+element, and a support joining several members would need a sum over members.
+
+Rotation unknowns are turned into moments by the rigid rotation they take part in: for a
+quaternion node with residual r_q (4), the moment m satisfies m · ω = r_q · δq for
+δq = ½ (0, ω) ⊗ q, so m = ½ G(q)ᵀ r_q with G(q) = [−vᵀ; q0 I − hat(v)]; a rotation vector's
+residual is its moment already, and the planar angle's is the moment about the plane normal.
+The balance check sums every nodal load by the same rigid motions (about the global origin, at
+the current positions for finite kinematics, the reference ones for linear), so follower and
+distributed loads and gravity enter as the forms state them.
+
+Supports in local axes and springs to ground are penalty springs in the energy
+(``Pi_ground``): their reaction is the spring force, minus its energy gradient.
+
+Everything is MPI-correct by construction: vectors are assembled with the reverse scatter, each
+rank sums its owned dofs, and the sums are reduced.
+"""
+
+import weakref
+from functools import partial
+from typing import NamedTuple
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from ..spec import DOF_NAMES
+from .dofs import constrained_dofs, owned_size
+
+
+class Reaction(NamedTuple):
+    """The reaction at a point (global axes): ``force``, ``moment`` about the point, and the
+    point's ``position`` (current for finite kinematics)."""
+
+    force: list
+    moment: list
+    position: list
+
+
+class Balance(NamedTuple):
+    """Σ reactions + Σ applied loads (forces, and moments about the origin), relative to the
+    load scale: Σ|f| over the nodes, and Σ(|x||f| + |m|) for the moments."""
+
+    force: float
+    moment: float
+    applied_force: list
+    applied_moment: list
+
+
+class _Layout(NamedTuple):
+    """Owned nodes of the displacement and rotation subspaces as rows of ``W`` dofs."""
+
+    u: np.ndarray  # (n, displacement comps) W dof indices
+    axes: list  # global axis of each displacement component
+    X: np.ndarray  # (n, 3) reference position of each displacement node
+    q: np.ndarray  # (m, rotation comps) W dof indices
+
+
+def _layout(model):
+    """Owned rows of the displacement and rotation nodes (a node's dofs share their owner)."""
+    owned = owned_size(model.W)
+    rows = []
+    for sub in (0, 1):
+        V, dofs = model.W.sub(sub).collapse()
+        n = model.kin.displacement_size if sub == 0 else model.kin.rotation_size
+        dofs = np.asarray(dofs).reshape(-1, n)
+        keep = dofs[:, 0] < owned
+        rows.append((dofs[keep], V.tabulate_dof_coordinates()[keep] if sub == 0 else None))
+    axes = [DOF_NAMES.index(name) for name, sub, _ in model.kin.dofs() if sub == 0]
+    return _Layout(rows[0][0], axes, rows[0][1], rows[1][0])
+
+
+def _nodal_moments(model, layout, r):
+    """Moment (global axes) of the rotation residual rows ``r`` at each owned rotation node."""
+    kin = model.kin
+    if kin.plane:
+        normal = np.eye(3)[DOF_NAMES.index(kin.dofs()[2][0]) - 3]
+        return r[:, :1] * normal
+    if not kin.finite:
+        return r
+    q = model.w.x.array[layout.q]
+    q0, v, r0, rv = q[:, :1], q[:, 1:], r[:, :1], r[:, 1:]
+    return 0.5 * (q0 * rv - r0 * v + np.cross(v, rv))
+
+
+def resultant(model, layout, values, mask):
+    """Σ force and Σ moment about the origin of the nodal ``values`` (an array on ``W``,
+    ghosts included) at the dofs where ``mask`` is true, with the scales of :class:`Balance`:
+    (force, moment, force scale, moment scale), summed over ranks. Collective."""
+    picked = np.where(mask, values, 0.0)
+    f = np.zeros((len(layout.u), 3))
+    f[:, layout.axes] = picked[layout.u]
+    x = np.array(layout.X)
+    if model.kin.finite:
+        x[:, layout.axes] += model.w.x.array[layout.u]
+    m = _nodal_moments(model, layout, picked[layout.q])
+    local = np.r_[
+        f.sum(0),
+        np.cross(x, f).sum(0) + m.sum(0),
+        np.linalg.norm(f, axis=1).sum(),
+        (np.linalg.norm(x, axis=1) * np.linalg.norm(f, axis=1)).sum()
+        + np.linalg.norm(m, axis=1).sum(),
+    ]
+    total = model.comm.allreduce(local, op=MPI.SUM)
+    return total[:3], total[3:6], total[6], total[7]
+
+
+def _vertex_dofs(model, at):
+    """Local W dofs (ghosts included) of every unknown at the named point ``at``."""
+    from dolfinx import fem
+
+    verts = model.mesh.point_tags.find(model.mesh.points[at][0])
+    sizes = (model.kin.displacement_size, model.kin.rotation_size)
+    dofs = [
+        fem.locate_dofs_topological(model.W.sub(sub).sub(comp), 0, verts)
+        for sub in (0, 1)
+        for comp in range(sizes[sub])
+    ]
+    return np.concatenate(dofs).astype(np.int64)
+
+
+class ReactionRecovery:
+    """Reactions of a :class:`~beamfx.analyses.formulation.BeamFormulation` at its current
+    state (:meth:`__call__`). Built once per model: two forms compiled (the residual, and the
+    gradient of ``Pi_ground`` if the model has springs or local-axes supports)."""
+
+    def __init__(self, model):
+        import dolfinx.fem.petsc as fp
+
+        from ..solvers.forms import compile_form
+
+        self.model, self.layout = model, _layout(model)
+        self.F = compile_form(model.F)
+        self.b = fp.create_vector(self.F)
+        self.ground = None
+        if model.Pi_ground is not None:
+            test = ufl.TestFunction(model.W)
+            self.ground = compile_form(ufl.derivative(model.Pi_ground, model.w, test))
+        n = len(model.w.x.array)
+        held = np.zeros(n, bool)
+        held[constrained_dofs(model.bcs)] = True
+        self.points = {}  # at -> (Dirichlet mask, spring mask)
+        spring_points = [s.at for s in model.spec.springs]
+        spring_points += [s.at for s in model.spec.supports if s.axes == "local"]
+        for at in dict.fromkeys([s.at for s in model.spec.supports] + spring_points):
+            at_point = np.zeros(n, bool)
+            at_point[_vertex_dofs(model, at)] = True
+            ground = at_point if at in spring_points else np.zeros(n, bool)
+            self.points[at] = (at_point & held, ground)
+
+    def _assemble(self, form, load_factor=None):
+        """``form`` assembled with no Dirichlet rows, ghosts updated; a copy of the array."""
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        if load_factor is not None:
+            self.model.load_factor.value = load_factor
+        with self.b.localForm() as local:
+            local.set(0.0)
+        fp.assemble_vector(self.b, form)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with self.b.localForm() as local:
+            return np.array(local.array)
+
+    def applied(self):
+        """The nodal load vector λ f_ext at the current state, F(λ=0) − F(λ=1) times λ."""
+        lam = float(self.model.load_factor.value)
+        try:
+            f = self._assemble(self.F, 0.0) - self._assemble(self.F, 1.0)
+        finally:
+            self.model.load_factor.value = lam
+        return lam * f
+
+    def __call__(self):
+        """``({point: Reaction}, Balance)`` at the current state. Collective."""
+        model, layout = self.model, self.layout
+        residual = self._assemble(self.F)
+        spring = -self._assemble(self.ground) if self.ground is not None else None
+        out, total = {}, np.zeros(6)
+        for at, (held, ground) in self.points.items():
+            force, moment, _, _ = resultant(model, layout, residual, held)
+            if spring is not None and ground.any():
+                f2, m2, _, _ = resultant(model, layout, spring, ground)
+                force, moment = force + f2, moment + m2
+            total += np.r_[force, moment]
+            x = _point_position(model, layout, at)
+            out[at] = Reaction(force.tolist(), (moment - np.cross(x, force)).tolist(), x.tolist())
+        load = self.applied()
+        force, moment, f_scale, m_scale = resultant(model, layout, load, np.ones(len(load), bool))
+        balance = Balance(
+            float(np.linalg.norm(total[:3] + force) / max(f_scale, 1e-300)),
+            float(np.linalg.norm(total[3:] + moment) / max(m_scale, 1e-300)),
+            force.tolist(),
+            moment.tolist(),
+        )
+        return out, balance
+
+
+def _point_position(model, layout, at):
+    """Position of the named point ``at`` (current for finite kinematics). Collective."""
+    dofs = _vertex_dofs(model, at)
+    rows = np.flatnonzero(np.isin(layout.u[:, 0], dofs))[:1]
+    x = np.array(layout.X[rows])
+    if model.kin.finite:
+        x[:, layout.axes] += model.w.x.array[layout.u[rows]]
+    local = np.r_[x.sum(0), len(rows)]
+    total = model.comm.allreduce(local, op=MPI.SUM)
+    return total[:3] / max(total[3], 1)
+
+
+def condensed_reactions(model, evaluate):
+    """Reaction at the clamp of the statically condensed cantilever, from the section
+    resultants at its start: force −RΛ0 N (statically exact: N is the sum of the loads beyond
+    the section), moment −RΛ0 M (M = C_M K recovered from the curvature, accurate to the
+    discretisation). ``evaluate(names)``: the probe values of the points (collective)."""
+    out = {}
+    for sup in model.spec.supports:
+        v = evaluate([sup.at])[sup.at]
+        axes = np.asarray(v["section_axes"])
+        force = -axes @ np.asarray(v["section_force"])
+        moment = -axes @ np.asarray(v["section_moment"])
+        out[sup.at] = Reaction(force.tolist(), moment.tolist(), list(v["position"]))
+    return out
+
+
+_recoveries = weakref.WeakKeyDictionary()  # model -> ReactionRecovery (forms compiled once)
+
+
+def entries(model):
+    """The ``reactions`` ({point: {force, moment, position}}) and ``reaction_balance`` (None
+    for the condensed model) entries of results.json at the model's current state. Collective.
+    """
+    from .formulation import BeamFormulation
+
+    if isinstance(model, BeamFormulation):
+        if model not in _recoveries:
+            _recoveries[model] = ReactionRecovery(model)
+        reactions, balance = _recoveries[model]()
+    else:
+        from ..io import evaluate_points
+
+        reactions, balance = (
+            condensed_reactions(model, partial(evaluate_points, model, recover=False)),
+            None,
+        )
+    return {
+        "reactions": {at: r._asdict() for at, r in reactions.items()},
+        "reaction_balance": None if balance is None else balance._asdict(),
+    }
+
+
+def balance_line(entry):
+    """One log line of :func:`entries`: the reaction points and the balance residuals."""
+    n, balance = len(entry["reactions"]), entry["reaction_balance"]
+    if balance is None:
+        return (
+            f"reactions: {n} support(s), from the section resultants at the clamp "
+            "(statically condensed model)"
+        )
+    applied = np.round(balance["applied_force"], 12).tolist()
+    return (
+        f"reactions: {n} point(s); balance with the applied loads (force {applied}): "
+        f"|ΣF|/scale = {balance['force']:.1e}, |ΣM|/scale = {balance['moment']:.1e}"
+    )
+
+
+__all__ = [
+    "Balance",
+    "Reaction",
+    "ReactionRecovery",
+    "balance_line",
+    "condensed_reactions",
+    "entries",
+    "resultant",
+]

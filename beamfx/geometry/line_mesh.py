@@ -1,0 +1,184 @@
+"""Line meshes of frames (towers, domes, lattices) read from a mesh file: nodes, straight
+members and the named groups of members and nodes.
+
+A gmsh ``.msh`` file (format 2.2 or 4.1, ASCII or binary) is read with meshio's gmsh reader,
+which needs no gmsh session: its physical groups of dimension 1 name groups of members, those
+of dimension 0 groups of nodes. Each two-node line element is one straight member. Knows nothing of sections or supports (:mod:`beamfx.scene.frames`
+maps the groups to them).
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+#: meshio cell types read as members and as named nodes
+LINE_TYPES, POINT_TYPES = ("line",), ("vertex",)
+CURVED_TYPES = ("line3", "line4")
+
+
+class LineMesh(NamedTuple):
+    """Nodes, members and named groups of a line mesh."""
+
+    points: np.ndarray  # (n, 3) node coordinates
+    members: np.ndarray  # (m, 2) node indices of each member, in file order, no duplicates
+    member_groups: dict  # {group name: member indices}
+    node_groups: dict  # {group name: node indices}
+    curves: tuple = ()  # per member: None (straight) or (k, 3) points along it (a .geo curve)
+
+
+def _group_names(field_data):
+    """{(dimension, tag): name} of the gmsh physical groups."""
+    out = {}
+    for name, value in field_data.items():
+        value = np.asarray(value).ravel()
+        if len(value) >= 2:
+            out[(int(value[1]), int(value[0]))] = name
+    return out
+
+
+def _blocks(mesh, path):
+    """(cell type, connectivity, physical tags or None) of each cell block."""
+    tags = mesh.cell_data.get("gmsh:physical")
+    out = []
+    for i, block in enumerate(mesh.cells):
+        if block.type in CURVED_TYPES:
+            raise ValueError(
+                f"{path}: {block.type} elements (curved members) are not supported yet; "
+                "write a first-order mesh (two-node lines)"
+            )
+        out.append((block.type, np.asarray(block.data), None if tags is None else tags[i]))
+    return out
+
+
+def read_line_mesh(path):
+    """The :class:`LineMesh` of the file at ``path``: a gmsh ``.msh`` mesh (each line element
+    a straight member) or a gmsh ``.geo`` geometry (:func:`read_geo_frame`).
+
+    Raises:
+        ValueError: naming the file, if it does not parse, holds no line element, has
+            non-finite coordinates or zero-length members.
+    """
+    if str(path).lower().endswith(".geo"):
+        return read_geo_frame(path)
+    import meshio.gmsh
+
+    try:  # the format's reader itself: meshio.read would print and sys.exit on a bad file
+        mesh = meshio.gmsh.read(str(path))
+    except Exception as e:  # noqa: BLE001 (meshio readers raise ReadError, KeyError, ...)
+        raise ValueError(f"{path}: not a mesh meshio can read ({type(e).__name__}: {e})") from None
+    points = np.asarray(mesh.points, float)
+    if points.ndim != 2 or not np.all(np.isfinite(points)):
+        raise ValueError(f"{path}: node coordinates are not finite numbers")
+    points = np.c_[points, np.zeros((len(points), 3 - points.shape[1]))][:, :3]
+    names = _group_names(mesh.field_data)
+    members, member_of, node_groups = {}, {}, {}
+    for kind, cells, tags in _blocks(mesh, path):
+        for k, cell in enumerate(cells):
+            tag = None if tags is None else int(tags[k])
+            if kind in LINE_TYPES:
+                key = tuple(int(v) for v in cell)
+                if key[::-1] in members:  # the same member twice would overlap itself
+                    raise ValueError(f"{path}: nodes {list(key)} are joined by two members")
+                index = members.setdefault(key, len(members))
+                name = names.get((1, tag))
+                if name is not None:
+                    member_of.setdefault(name, []).append(index)
+            elif kind in POINT_TYPES and names.get((0, tag)) is not None:
+                node_groups.setdefault(names[(0, tag)], []).append(int(cell[0]))
+    if not members:
+        raise ValueError(f"{path}: no line elements (members) in the mesh")
+    lines = np.array(list(members), np.int64)
+    lengths = np.linalg.norm(points[lines[:, 1]] - points[lines[:, 0]], axis=1)
+    if np.any(lengths <= 1e-12 * max(np.ptp(points), 1e-300)):
+        i = int(np.argmin(lengths))
+        raise ValueError(f"{path}: member {i + 1} (nodes {lines[i].tolist()}) has zero length")
+    return LineMesh(
+        points,
+        lines,
+        {k: np.unique(v) for k, v in member_of.items()},
+        {k: np.unique(v) for k, v in node_groups.items()},
+    )
+
+
+def read_geo_frame(path, samples=201):
+    """The :class:`LineMesh` of a gmsh ``.geo`` file (read by
+    :func:`~beamfx.geometry.curves.read_gmsh`, no meshing): each curve (1D entity) is one
+    member between its two end points, straight or curved (then sampled along gmsh's
+    parametrisation); physical groups of curves and points name member and node groups."""
+    from .curves import read_gmsh
+
+    return read_gmsh(path, lambda gmsh: _geo_frame(gmsh, str(path), samples))
+
+
+def _geo_frame(gmsh, path, samples):
+    """:func:`read_geo_frame` on the open gmsh model."""
+    nodes, points, members, curves, index = {}, [], [], [], {}
+
+    def node(tag):
+        if tag not in nodes:
+            nodes[tag] = len(points)
+            points.append(np.reshape(gmsh.model.getValue(0, tag, []), 3))
+        return nodes[tag]
+
+    for _, tag in gmsh.model.getEntities(1):
+        ends = [t for _, t in gmsh.model.getBoundary([(1, tag)], combined=False, oriented=False)]
+        if len(ends) != 2 or ends[0] == ends[1]:
+            raise ValueError(f"{path}: curve {tag} is closed; split it into members with two ends")
+        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+        xyz = np.reshape(gmsh.model.getValue(1, tag, np.linspace(lo[0], hi[0], samples)), (-1, 3))
+        a, b = node(ends[0]), node(ends[1])
+        if np.linalg.norm(xyz[0] - points[a]) > np.linalg.norm(xyz[0] - points[b]):
+            a, b = b, a  # members run along the parametrisation
+        chord = xyz[-1] - xyz[0]
+        off = np.cross(xyz - xyz[0], chord / max(np.linalg.norm(chord), 1e-300))
+        straight = np.abs(off).max() <= 1e-9 * np.linalg.norm(chord)
+        index[tag] = len(members)
+        members.append((a, b))
+        curves.append(None if straight else xyz)
+    if not members:
+        raise ValueError(f"{path}: no curves (members) in the file")
+    groups = {1: {}, 0: {}}
+    for dim, ptag in gmsh.model.getPhysicalGroups():
+        name = gmsh.model.getPhysicalName(dim, ptag) or str(ptag)
+        tags = gmsh.model.getEntitiesForPhysicalGroup(dim, ptag)
+        if dim in groups:
+            ids = [index[t] for t in tags] if dim == 1 else [node(t) for t in tags]
+            groups[dim][name] = np.unique(np.asarray(ids, np.int64))
+    lines = np.array(members, np.int64)
+    return LineMesh(np.array(points), lines, groups[1], groups[0], tuple(curves))
+
+
+def write_line_mesh(path, points, members, member_groups, node_groups):
+    """Write a gmsh 2.2 ASCII ``.msh`` with the groups as physical groups (the examples in
+    meshes/ are made with it): ``member_groups`` {name: member indices}, ``node_groups``
+    {name: node indices}; a member in no group is written without one."""
+    import meshio
+
+    line_cells, line_tags, vertex_cells, vertex_tags, field_data = [], [], [], [], {}
+    grouped = np.zeros(len(members), bool)
+    for tag, (name, idx) in enumerate(member_groups.items(), start=1):
+        field_data[name] = np.array([tag, 1])
+        line_cells += [members[i] for i in idx]
+        line_tags += [tag] * len(idx)
+        grouped[list(idx)] = True
+    line_cells += [m for m, g in zip(members, grouped) if not g]
+    line_tags += [0] * int(np.count_nonzero(~grouped))
+    for tag, (name, idx) in enumerate(node_groups.items(), start=len(member_groups) + 1):
+        field_data[name] = np.array([tag, 0])
+        vertex_cells += [[i] for i in idx]
+        vertex_tags += [tag] * len(idx)
+    cells = [("line", np.array(line_cells, np.int64))]
+    tags = [np.array(line_tags, np.int32)]
+    if vertex_cells:
+        cells.append(("vertex", np.array(vertex_cells, np.int64)))
+        tags.append(np.array(vertex_tags, np.int32))
+    mesh = meshio.Mesh(
+        np.asarray(points, float),
+        cells,
+        cell_data={"gmsh:physical": tags, "gmsh:geometrical": tags},
+        field_data=field_data,
+    )
+    meshio.write(str(path), mesh, file_format="gmsh22", binary=False)
+
+
+__all__ = ["LineMesh", "read_geo_frame", "read_line_mesh", "write_line_mesh"]
