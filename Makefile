@@ -22,7 +22,7 @@ run: install
 test: install
 	$(PY) -m pytest -n 2 -m "not slow and not mpi and not paraview" tests
 	$(PY) -m pytest -p no:cacheprovider -m "paraview and not slow" tests
-	$(MPIRUN) $(PY) -m pytest -p no:cacheprovider -m mpi tests/; rc=$$?; \
+	$(MPIRUN) $(PY) -m pytest -p no:cacheprovider -m "mpi and not slow" tests/; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "(no MPI tests collected)"; rc=0; fi; exit $$rc
 
 test-slow: install
