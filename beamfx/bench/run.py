@@ -32,6 +32,8 @@ def run_setting(case, elements, degree):
         jit = compile_seconds[0] - c0
         warm_run, warm = run_in_process(scene, folder)
     result = warm_run.result
+    if result.status != "converged":  # a bench setting that fails is a finding, said as such
+        raise RuntimeError(f"{case.id} {elements} x P{degree}: {result.status}: {result.reason}")
     path = [
         {"load_factor": float(p["load_factor"]), **case.measure(p["probes"])}
         for p in run.result.path
