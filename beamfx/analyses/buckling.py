@@ -308,7 +308,7 @@ def _inertia(model, K):
     """Negative eigenvalues of the tangent ``K`` (None for state-dependent loads, whose
     tangent is unsymmetric: no inertia)."""
     from ..solvers.inertia import InertiaCounter
-    from .continuation import state_dependent_loads
+    from .static import state_dependent_loads
 
     if state_dependent_loads(model):
         return None

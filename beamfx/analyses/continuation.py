@@ -15,7 +15,7 @@ from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
 from ..spec import DOF_NAMES
 from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
-from .static import state_sizes
+from .static import state_dependent_loads, state_sizes
 
 
 class PathPoint(NamedTuple):
@@ -196,14 +196,6 @@ def model_size(model):
     x = model.mesh.mesh.geometry.x
     local = float(np.ptp(x, axis=0).max()) if len(x) else 0.0
     return model.comm.allreduce(local, op=MPI.MAX)
-
-
-def state_dependent_loads(model):
-    """Whether the load vector depends on the state (then the tangent is unsymmetric): for
-    follower and semitangential loads, and for fixed moments under finite rotations (their
-    work is M·δθ with δθ a function of q)."""
-    loads = (*model.spec.point_loads, *model.spec.distributed_loads)
-    return any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)
 
 
 def limit_points(path):

@@ -16,6 +16,7 @@ class StaticResult(NamedTuple):
     newton_iterations: int
     seconds: dict  # wall time of this call: compile, assemble_F, assemble_J, solve (factorise,
     # triangular_solve, python), total
+    negative_eigenvalues: tuple = ()  # of the tangent after each accepted step (or empty)
 
 
 class _State(SavedState):
@@ -78,13 +79,22 @@ def state_sizes(model):
 
 
 def solve_static(
-    model, steps=10, options=None, prefix="beamfx_static_", on_step=None, log=None, solver=None
+    model,
+    steps=10,
+    options=None,
+    prefix="beamfx_static_",
+    on_step=None,
+    log=None,
+    solver=None,
+    inertia=False,
 ):
     """Nonlinear static equilibrium at load factor 1, reached by adaptive load stepping.
 
     The linear kinematics take a single step (the problem is linear). Newton's test
     (:mod:`~beamfx.solvers.convergence`) scales the residual by the load vector's norm (or
     the reactions) and knows the round-off floor of the model's stiffness and state.
+    ``inertia``: count the negative eigenvalues of the tangent after every accepted step
+    (one LDLᵀ factorisation more per step; symmetric tangents of finite kinematics only).
     """
     t0 = time.perf_counter()
     from ..solvers.forms import compile_seconds
@@ -107,7 +117,73 @@ def solve_static(
 
     n = 1 if not model.kin.finite else steps
     before = dict(solver.seconds)
-    history = step_load(solve_at, _State(model.w), steps=n, on_step=on_step, log=log)
+    counts, counted = [], _inertia_counter(model, inertia)
+
+    def accepted(step):
+        if counted is not None:  # the tangent at the converged state, assembled once more
+            counts.append(counted.count_tangent(solver))
+        if on_step:
+            on_step(step)
+
+    try:
+        history = step_load(solve_at, _State(model.w), steps=n, on_step=accepted, log=log)
+    finally:
+        if counted is not None:
+            counted.destroy()
     spent = {k: v - before.get(k, 0.0) for k, v in solver.seconds.items()}
+    if counted is not None:
+        spent["inertia"] = counted.seconds
     seconds = {"compile": compile_time, **spent, "total": time.perf_counter() - t0}
-    return StaticResult(tuple(history), int(np.sum([h.iterations for h in history])), seconds)
+    its = int(np.sum([h.iterations for h in history]))
+    return StaticResult(tuple(history), its, seconds, tuple(counts))
+
+
+def _inertia_counter(model, inertia):
+    """An LDLᵀ inertia counter where asked and meaningful: finite kinematics (a linear solve
+    has nothing to pass) and a symmetric tangent (no state-dependent load)."""
+    if not inertia or not model.kin.finite or state_dependent_loads(model):
+        return None
+    return _TangentInertia(model.comm)
+
+
+class _TangentInertia:
+    """Negative eigenvalues of a Newton solver's tangent at its current state: the compiled
+    tangent assembled into a matrix of its own (the solver's is SNES's to manage), then one
+    LDLᵀ factorisation (:class:`~beamfx.solvers.inertia.InertiaCounter`)."""
+
+    def __init__(self, comm):
+        from ..solvers.inertia import InertiaCounter
+
+        self.counter = InertiaCounter(comm, "beamfx_static_inertia_")
+        self.A = None
+        self.seconds = 0.0
+
+    def count_tangent(self, solver):
+        """Assemble ``solver``'s tangent (with its coupling) and count."""
+        import dolfinx.fem.petsc as fp
+
+        from ..solvers.assembly import assemble_tangent
+
+        t = time.perf_counter()
+        if self.A is None:
+            self.A = fp.create_matrix(solver.J)
+        assemble_tangent(self.A, solver.J, solver.bcs)
+        if solver.coupling:
+            solver.coupling.add_to_tangent(self.A)
+        n = self.counter.count(self.A)
+        self.seconds += time.perf_counter() - t
+        return n
+
+    def destroy(self):
+        """Free the matrix and the factorisation."""
+        self.counter.destroy()
+        if self.A is not None:
+            self.A.destroy()
+
+
+def state_dependent_loads(model):
+    """Whether the load vector depends on the state (then the tangent is unsymmetric): for
+    follower and semitangential loads, and for fixed moments under finite rotations (their
+    work is M·δθ with δθ a function of q)."""
+    loads = (*model.spec.point_loads, *model.spec.distributed_loads)
+    return any(ld.kind != "dead" or (model.kin.finite and any(ld.moment)) for ld in loads)

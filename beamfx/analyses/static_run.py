@@ -44,10 +44,32 @@ def solve(model: Formulation, settings: Settings, ctx: RunContext) -> tuple["Sta
         path.append({"load_factor": step.load_factor, "probes": values, "reactions": reactions})
 
     opts = ctx.solver_options
-    solved = solve_static(model, steps=settings.steps, options=opts, on_step=on_step, log=ctx.log)
+    solved = solve_static(
+        model, steps=settings.steps, options=opts, on_step=on_step, log=ctx.log, inertia=True
+    )
+    for point, count in zip(path, solved.negative_eigenvalues):
+        point["negative_eigenvalues"] = count
+    for note in critical_points(solved.steps, solved.negative_eigenvalues):
+        ctx.log(f"  {note}")
     if solved.steps:
         ctx.last_frame(solved.steps[-1].step, solved.steps[-1].load_factor)
     return solved, tuple(path)
+
+
+def critical_points(steps, counts):
+    """Sentences for each change of the tangent's negative eigenvalues between accepted load
+    steps: a critical point (limit or bifurcation) passed in load control, the state beyond it
+    unstable."""
+    out, previous = [], (0.0, 0)
+    for step, count in zip(steps, counts):
+        if count != previous[1]:
+            out.append(
+                f"negative eigenvalues of the tangent {previous[1]} -> {count} between load "
+                f"factors {previous[0]:.6g} and {step.load_factor:.6g}: a critical point passed"
+                + (" (the state is unstable)" if count > 0 else "")
+            )
+        previous = (step.load_factor, count)
+    return out
 
 
 def run(model: Formulation, settings: Settings, ctx: RunContext) -> Result:

@@ -89,3 +89,32 @@ modes = 2
     assert abs(first * factor - 1) < 1e-4
     assert (first < 1) == (passed == 1)
     assert all(x > 1 for x in results["load_factors"])  # sign = "positive": above the state
+
+
+def test_a_static_run_past_the_euler_load_counts_the_critical_point(tmp_path):
+    """Load control along the perfect column's straight path to 1.5 P_e in 10 steps: the
+    tangent has one negative eigenvalue from 1.05 P_e on (the weak axis buckles at P_e, the
+    strong one at 4 P_e), and the log names the interval where the count changed."""
+    text = (
+        COLUMN
+        + f"""
+[[loads]]
+at = "column:end"
+force = [{-1.5 * P_E!r}, 0, 0]
+
+[model]
+plane = "none"
+
+[analysis]
+type = "static"
+steps = 10
+"""
+    )
+    messages = []
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text + f'\n[output]\ndir = "{tmp_path / "out"}"\n')
+    results = run_scene(scene, log=messages.append)
+    assert results["status"] == "converged"
+    counts = [p["negative_eigenvalues"] for p in results["path"]]
+    assert counts == [0] * 6 + [1] * 4
+    assert any("0 -> 1 between load factors 0.6 and 0.7" in m for m in messages), messages
