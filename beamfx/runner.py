@@ -93,9 +93,8 @@ def run_scene(
     from .io import log as default_log
     from .io.folder import claim
 
-    comm = comm or MPI.COMM_WORLD
+    comm, t_start = comm or MPI.COMM_WORLD, time.perf_counter()
     log = log or partial(default_log, comm=comm)
-    t_start = time.perf_counter()
     path = Path(path) if path else default_scene_path()
     if scene is None:
         from .scene import Sweep, load_scene_or_sweep

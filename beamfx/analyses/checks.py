@@ -172,11 +172,17 @@ def check_supported(model):
         )
 
 
+def takes_free_body(settings, model):
+    """Whether the analysis of ``settings`` takes ``model`` without supports: its settings say
+    so with ``free_body(model) -> bool`` (a modal analysis without pre-stress, a transient from
+    rest: their operators K - ω²M and M/(β Δt²) + K are regular); False if they have no say."""
+    return bool(getattr(settings, "free_body", lambda model: False)(model))
+
+
 def check_supports_for(model, settings):
-    """:func:`check_supported`, unless the analysis takes a free structure: its settings say so
-    with ``free_body(model) -> bool`` (a modal analysis without pre-stress, a transient from
-    rest: their operators K - ω²M and M/(β Δt²) + K are regular)."""
-    if not getattr(settings, "free_body", lambda model: False)(model):
+    """:func:`check_supported`, unless the analysis takes a free structure
+    (:func:`takes_free_body`)."""
+    if not takes_free_body(settings, model):
         check_supported(model)
 
 

@@ -9,15 +9,11 @@ from .registry import Case
 def case_scene(case, elements, degree, analysis="static", **settings):
     """The scene of one setting of a case, as ``beamfx run`` takes it (built in code)."""
     from ..analyses.registry import analysis as lookup
-    from ..scene.load import Scene
 
     spec, steps = case.build(elements, degree)
-    entry = lookup(analysis)
-    if "steps" in {f.name for f in fields(entry.settings)}:
+    if "steps" in {f.name for f in fields(lookup(analysis).settings)}:
         settings.setdefault("steps", steps)
-    return Scene(
-        f"bench:{case.id}", spec, analysis, dict(case.probes), settings=entry.settings(**settings)
-    )
+    return analysis_scene(case.id, spec, analysis, case.probes, **settings)
 
 
 def setting_scene(case, setting):

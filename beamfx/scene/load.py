@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analyses.checks import takes_free_body
 from ..analyses.trimming import PLANE_CHOICES
 from ..physics.kinematics import PLANES, Kinematics
 from ..solvers.options import option_problems
@@ -103,7 +104,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     )
     _check_points(model, probes, file, data.get("loads", []))
     _check_histories(model, settings, file, data.get("loads", []))
-    if not model.supports and not getattr(settings, "free_body", lambda m: False)(model):
+    if not model.supports and not takes_free_body(settings, model):
         raise SceneError(
             f"{file}: supports: none given; the structure is free (rigid-body motion), which "
             "only a modal analysis without pre-stress or a transient from rest can take"
@@ -258,8 +259,7 @@ def _trim(model, plane, analysis, settings):
     if not analysis.plane:
         why = f"full model: a {analysis.name} analysis has out-of-plane modes"
         return model, Trim(None, True, why)
-    free_body = getattr(settings, "free_body", lambda model: False)(model)
-    trim = choose_plane(model, analysis.name, asdict(settings), free_body)
+    trim = choose_plane(model, analysis.name, asdict(settings), takes_free_body(settings, model))
     if trim.plane:
         model = replace(model, kinematics=replace(model.kinematics, plane=trim.plane))
     return model, trim

@@ -179,28 +179,13 @@ class NewtonSolver:
             self.test.linear(self.x, self._residuals[-1])
         seconds = self._split(before, linear_before, time.perf_counter() - t)
         reason = reason_names().get(code, str(code))
+        done = (reason, self.snes.getIterationNumber(), tuple(self._residuals), seconds)
         if code > 0 and self.test.how is not None:
-            return SolveReport(
-                True,
-                reason,
-                self.snes.getIterationNumber(),
-                tuple(self._residuals),
-                seconds,
-                criterion=self.test.how,
-                scale=self.test.records[-1]["scale"],
-            )
+            scale = self.test.records[-1]["scale"]
+            return SolveReport(True, *done, criterion=self.test.how, scale=scale)
         floor = self.test.absolute.floor(self.A, self.x, self.sizes)
         cause, detail = diagnose(reason, self.test.records, floor)
-        return SolveReport(
-            False,
-            reason,
-            self.snes.getIterationNumber(),
-            tuple(self._residuals),
-            seconds,
-            cause=cause,
-            detail=detail,
-            floor=floor,
-        )
+        return SolveReport(False, *done, cause=cause, detail=detail, floor=floor)
 
     def _split(self, before, linear_before, total):
         """This solve's wall-time split (and the running totals in ``self.seconds``)."""
