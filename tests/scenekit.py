@@ -111,3 +111,35 @@ def cantilever(history=pulse, force=(0.0, 300.0, 400.0), elements=2, degree=2, k
         (PointLoad("b:end", force, (0.0, 0.0, 0.0), "dead", history),),
         kinematics=kin or Kinematics(),
     )
+
+
+#: the hub's angle of the spin-up of tests/scenes/test_restart.py: the tip passes 2π at 0.96 s
+SPIN_HISTORY = "where(t < 0.5, 4 * (t - (0.5 / pi) * sin(pi * t / 0.5)), 8 * t - 2)"
+
+
+def spun_beam(history, t_end, dt=0.005, plane="none", checkpoint_every=None):
+    """A transient scene: a 10 m beam clamped to a hub turning about z by ``history``, the
+    tip probed (the spin-up of the restart, MPI-failure and VM258 tests)."""
+    checkpoints = "" if checkpoint_every is None else f"checkpoint_every = {checkpoint_every}\n"
+    return f"""
+[[beams]]
+name = "beam"
+curve = {{ shape = "line", start = [0, 0, 0], end = [10, 0, 0] }}
+section = {{ type = "general", EA = 2.8e7, GA_y = 1e7, GA_z = 1e7, GJ = 1.4e4, EI_y = 1.4e4, EI_z = 1.4e4, rho_A = 1.2, rho_I = [1.2e-3, 6e-4, 6e-4] }}
+elements = 4
+degree = 2
+[model]
+plane = "{plane}"
+[[supports]]
+at = "beam:start"
+fix = "all"
+rotation = [0, 0, 1]
+history = "{history}"
+[analysis]
+type = "transient"
+t_end = {t_end!r}
+dt = {dt!r}
+{checkpoints}[[probes]]
+name = "tip"
+at = "beam:end"
+"""

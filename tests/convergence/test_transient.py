@@ -5,7 +5,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scenekit import CLAMP, RHO, E, G, cantilever, flying_spaghetti
+from scenekit import CLAMP, RHO, E, G, cantilever, flying_spaghetti, spun_beam
 
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
@@ -86,28 +86,12 @@ def test_damped_motion_settles_to_the_static_answer():
     assert abs(e["numerical"]) < 0.02 * e["dissipated_damping"]
 
 
-SPIN = """
-[[beams]]
-name = "beam"
-curve = { shape = "line", start = [0, 0, 0], end = [10, 0, 0] }
-section = { type = "general", EA = 2.8e7, GA_y = 1e7, GA_z = 1e7, GJ = 1.4e4, EI_y = 1.4e4, EI_z = 1.4e4, rho_A = 1.2, rho_I = [1.2e-3, 6e-4, 6e-4] }
-elements = 4
-degree = 2
-[model]
-plane = "xy"
-[[supports]]
-at = "beam:start"
-fix = "all"
-rotation = [0, 0, 1]
-history = "where(t < 15, (6/15) * (t**2/2 + (15/(2*pi))**2 * (cos(2*pi*t/15) - 1)), 6*t - 45)"
-[analysis]
-type = "transient"
-t_end = 18.0
-dt = 0.0125
-[[probes]]
-name = "tip"
-at = "beam:end"
-"""
+SPIN = spun_beam(
+    "where(t < 15, (6/15) * (t**2/2 + (15/(2*pi))**2 * (cos(2*pi*t/15) - 1)), 6*t - 45)",
+    18.0,
+    dt=0.0125,
+    plane="xy",
+)
 
 
 def test_spin_up_reaches_the_centrifugal_stretch(tmp_path):

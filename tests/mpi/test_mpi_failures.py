@@ -14,6 +14,7 @@ import sys
 import time
 
 import pytest
+from scenekit import SPIN_HISTORY, spun_beam
 
 pytestmark = [
     pytest.mark.mpi,
@@ -23,37 +24,10 @@ pytestmark = [
     pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun"),
 ]
 
-SCENE = """
-[[beams]]
-name = "beam"
-curve = { shape = "line", start = [0, 0, 0], end = [10, 0, 0] }
-section = { type = "general", EA = 2.8e7, GA_y = 1e7, GA_z = 1e7, GJ = 1.4e4, EI_y = 1.4e4, EI_z = 1.4e4, rho_A = 1.2, rho_I = [1.2e-3, 6e-4, 6e-4] }
-elements = 4
-degree = 2
-[model]
-plane = "none"
-[[supports]]
-at = "beam:start"
-fix = "all"
-rotation = [0, 0, 1]
-history = "4 * t**2"
-[analysis]
-type = "transient"
-t_end = 0.1
-dt = 0.005
-checkpoint_every = 5
-[[probes]]
-name = "tip"
-at = "beam:end"
-"""
+SCENE = spun_beam("4 * t**2", 0.1, checkpoint_every=5)
 #: the spin-up of tests/scenes/test_restart.py: the tip turns past 2π by t = 0.96
-SPIN = (
-    SCENE.replace(
-        '"4 * t**2"', '"where(t < 0.5, 4 * (t - (0.5 / pi) * sin(pi * t / 0.5)), 8 * t - 2)"'
-    )
-    .replace("t_end = 0.1", "t_end = 3.0")  # 600 steps: mpirun passes SIGINT on in time
-    .replace("checkpoint_every = 5", "checkpoint_every = 20")
-)
+# 600 steps: long enough for mpirun to pass a SIGINT on to the ranks mid-run
+SPIN = spun_beam(SPIN_HISTORY, 3.0, checkpoint_every=20)
 LIMIT = 240  # s: a hang would be killed here (a run takes about 10 s)
 
 

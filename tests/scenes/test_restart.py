@@ -19,32 +19,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scenekit import SPIN_HISTORY, spun_beam
 
 from beamfx.cli import main
 
-SPIN = """
-[[beams]]
-name = "beam"
-curve = { shape = "line", start = [0, 0, 0], end = [10, 0, 0] }
-section = { type = "general", EA = 2.8e7, GA_y = 1e7, GA_z = 1e7, GJ = 1.4e4, EI_y = 1.4e4, EI_z = 1.4e4, rho_A = 1.2, rho_I = [1.2e-3, 6e-4, 6e-4] }
-elements = 4
-degree = 2
-[model]
-plane = "none"
-[[supports]]
-at = "beam:start"
-fix = "all"
-rotation = [0, 0, 1]
-history = "where(t < 0.5, 4 * (t - (0.5 / pi) * sin(pi * t / 0.5)), 8 * t - 2)"
-[analysis]
-type = "transient"
-t_end = 1.2
-dt = 0.005
-checkpoint_every = 20
-[[probes]]
-name = "tip"
-at = "beam:end"
-"""
+SPIN = spun_beam(SPIN_HISTORY, 1.2, checkpoint_every=20)
 
 
 def beamfx(*args, cwd):
