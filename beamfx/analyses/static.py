@@ -121,7 +121,7 @@ def solve_static(
 
     def accepted(step):
         if counted is not None:  # the tangent at the converged state, assembled once more
-            counts.append(counted.count_tangent(solver))
+            counts.append(counted.count(solver.J, solver.bcs, solver.coupling))
         if on_step:
             on_step(step)
 
@@ -143,42 +143,9 @@ def _inertia_counter(model, inertia):
     has nothing to pass) and a symmetric tangent (no state-dependent load)."""
     if not inertia or not model.kin.finite or state_dependent_loads(model):
         return None
-    return _TangentInertia(model.comm)
+    from ..solvers.inertia import TangentInertia
 
-
-class _TangentInertia:
-    """Negative eigenvalues of a Newton solver's tangent at its current state: the compiled
-    tangent assembled into a matrix of its own (the solver's is SNES's to manage), then one
-    LDLᵀ factorisation (:class:`~beamfx.solvers.inertia.InertiaCounter`)."""
-
-    def __init__(self, comm):
-        from ..solvers.inertia import InertiaCounter
-
-        self.counter = InertiaCounter(comm, "beamfx_static_inertia_")
-        self.A = None
-        self.seconds = 0.0
-
-    def count_tangent(self, solver):
-        """Assemble ``solver``'s tangent (with its coupling) and count."""
-        import dolfinx.fem.petsc as fp
-
-        from ..solvers.assembly import assemble_tangent
-
-        t = time.perf_counter()
-        if self.A is None:
-            self.A = fp.create_matrix(solver.J)
-        assemble_tangent(self.A, solver.J, solver.bcs)
-        if solver.coupling:
-            solver.coupling.add_to_tangent(self.A)
-        n = self.counter.count(self.A)
-        self.seconds += time.perf_counter() - t
-        return n
-
-    def destroy(self):
-        """Free the matrix and the factorisation."""
-        self.counter.destroy()
-        if self.A is not None:
-            self.A.destroy()
+    return TangentInertia(model.comm, "beamfx_static_inertia_")
 
 
 def state_dependent_loads(model):

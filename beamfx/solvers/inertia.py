@@ -93,26 +93,54 @@ class InertiaCounter:
         self.ksp.destroy()
 
 
+class TangentInertia:
+    """Negative eigenvalues of a compiled tangent form at the current state of its
+    coefficients: assembled into a matrix of its own (identity Dirichlet rows, and a
+    coupling's entries if given), then one LDLᵀ factorisation; the matrix and the symbolic
+    analysis are kept between calls."""
+
+    def __init__(self, comm, prefix="beamfx_inertia_", options=None):
+        self.counter = InertiaCounter(comm, prefix, options)
+        self.A = None
+        self.seconds = 0.0  # assembly and factorisation
+
+    def count(self, J, bcs, coupling=None):
+        """Assemble ``J`` (compiled) and count."""
+        import dolfinx.fem.petsc as fp
+
+        from .assembly import assemble_tangent
+
+        t = time.perf_counter()
+        if self.A is None:
+            self.A = fp.create_matrix(J)
+        assemble_tangent(self.A, J, bcs)
+        if coupling:
+            coupling.add_to_tangent(self.A)
+        n = self.counter.count(self.A)
+        self.seconds += time.perf_counter() - t
+        return n
+
+    def destroy(self):
+        """Free the matrix and the factorisation."""
+        self.counter.destroy()
+        if self.A is not None:
+            self.A.destroy()
+
+
 def tangent_inertia(J, bcs, comm, prefix="beamfx_inertia_", options=None):
     """Negative eigenvalues of the tangent form ``J`` (compiled) with identity Dirichlet rows,
     at the current state of its coefficients. One assembly and one factorisation."""
-    import dolfinx.fem.petsc as fp
-
-    from .assembly import assemble_tangent
-
-    A = fp.create_matrix(J)
-    assemble_tangent(A, J, bcs)
-    counter = InertiaCounter(comm, prefix, options)
+    counter = TangentInertia(comm, prefix, options)
     try:
-        return counter.count(A)
+        return counter.count(J, bcs)
     finally:
         counter.destroy()
-        A.destroy()
 
 
 __all__ = [
     "DEFAULT_OPTIONS",
     "InertiaCounter",
+    "TangentInertia",
     "counts_inertia",
     "negative_pivots",
     "tangent_inertia",
