@@ -207,7 +207,6 @@ class ScaledTest:
             return None
         if not self.increment_small(record, x):
             return None
-        record["resolved"] = fnorm / scale if scale > 0 else None
         self.how = "floor"
         return self.how
 
