@@ -17,6 +17,7 @@ def all_cases():
         classic,
         coupled_cantilever,
         howcroft_2016,
+        nrel5mw_blade,
         pai_beam,
         planar_rollup,
         schwab_meijaard_2009,
