@@ -97,6 +97,7 @@ class Result(_Base):
     stopped_by: str | None = entry("why the sweep of speeds ended early (a lost steady state)")
     files: dict = entry("campbell.csv and campbell.png")
     steady_newton_iterations: tuple = entry("Newton iterations of each steady state")
+    path: tuple = entry("speed and the probes' values of each steady state")
 
     def summary(self) -> dict:
         """The numbers of a sweep table: the frequencies (Hz) and why the sweep stopped."""
@@ -129,13 +130,21 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         f"{settings.hub if isinstance(settings.hub, str) else 'the hub'} "
         f"{np.round(hub, 6).tolist()}, {len(settings.speeds)} speed(s)"
     )
+    path = []
+
+    def on_speed(i, speed):  # the steady state: probes and a frame (no reactions: their
+        ctx.probe_values(model)  # balance would need the centrifugal load, not a scene load)
+        ctx.frames.write(i, float(speed))  # every speed: the Campbell diagram's states
+        values = {name: ctx.latest[at] for name, at in ctx.probes.items()}
+        path.append({"speed_rad_s": float(speed), "probes": values})
+
     result = campbell(
         frame,
         settings.speeds,
         settings.modes,
         steps=settings.steps,
         options=ctx.solver_options,
-        on_speed=lambda i, speed: ctx.frames.write(i, float(speed)),  # the steady state
+        on_speed=on_speed,
         log=ctx.log,
     )
     frame.destroy()
@@ -166,6 +175,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         stopped_by=result.stopped_by,
         files={"csv": "campbell.csv", "png": "campbell.png"},
         steady_newton_iterations=tuple(s.newton_iterations for s in result.steady),
+        path=tuple(path),
     )
 
 

@@ -19,6 +19,7 @@ def all_cases():
         howcroft_2016,
         nrel5mw_blade,
         pai_beam,
+        pai_rotating,
         planar_rollup,
         schwab_meijaard_2009,
         schwab_meijaard_eigen,

@@ -337,3 +337,30 @@ def test_a_speed_without_steady_state_stops_the_run_with_exit_status_3(tmp_path)
     assert results["converged"] is False and results["status"] == "stopped"
     assert results["reason"] == results["stopped_by"] and results["reason"]
     assert results["speeds_rad_s"] == [0, 1000]
+
+
+def test_the_steady_state_of_each_speed_is_in_the_path_and_at_rest_it_is_the_static_one(tmp_path):
+    """The pre-curved Pai beam under gravity (beamfx/scenes/pai_rotating.toml): results'
+    ``path`` has the tip of every steady state; at 0 rad/s it is the static equilibrium under
+    the same loads (the same full 3D model: no trimming; both solved to the convergence test's tolerance, about 1e-8 of
+    the force scale), and spinning lifts the strip."""
+    import tomllib
+    from importlib import resources
+
+    from beamfx.scene.load import parse_scene
+
+    data = tomllib.loads(resources.files("beamfx.scenes").joinpath("pai_rotating.toml").read_text())
+    data["beams"][0].update(elements=4, degree=2)
+    data["analysis"].update(speeds_rad_s=[0.0, 12.0], modes=1)
+    runs = {}
+    for kind, analysis in (("rotating", data["analysis"]), ("static", {"type": "static"})):
+        full = {"plane": "none", "condense": "none"}
+        scene = parse_scene({**data, "analysis": analysis, "model": full}, "pai_rotating.toml")
+        quiet = lambda *a, **k: None  # noqa: E731
+        runs[kind] = run_scene(scene.file, tmp_path / kind, log=quiet, scene=scene).result
+    path = runs["rotating"].path
+    assert [p["speed_rad_s"] for p in path] == [0.0, 12.0]
+    at_rest = np.array(path[0]["probes"]["tip"]["position"])
+    static = np.array(runs["static"].path[-1]["probes"]["tip"]["position"])
+    assert np.abs(at_rest - static).max() < 1e-7 * 0.479
+    assert path[1]["probes"]["tip"]["position"][2] > at_rest[2] + 0.05  # lifted by 0.12 m
