@@ -356,7 +356,7 @@ def test_the_steady_state_of_each_speed_is_in_the_path_and_at_rest_it_is_the_sta
     for kind, analysis in (("rotating", data["analysis"]), ("static", {"type": "static"})):
         full = {"plane": "none", "condense": "none"}
         scene = parse_scene({**data, "analysis": analysis, "model": full}, "pai_rotating.toml")
-        quiet = lambda *a, **k: None  # noqa: E731
+        quiet = lambda *a, **k: None
         runs[kind] = run_scene(scene.file, tmp_path / kind, log=quiet, scene=scene).result
     path = runs["rotating"].path
     assert [p["speed_rad_s"] for p in path] == [0.0, 12.0]
