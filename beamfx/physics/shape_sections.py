@@ -133,6 +133,12 @@ def _analyse(geometry, mesh_size):
     d2 = p.Delta_s**2  # A_s = Δ_s²/κ: back to the coefficients κ, then the 2×2 inverse
     kappa = np.array([[d2 / p.A_sx, d2 / p.A_sxy], [d2 / p.A_sxy, d2 / p.A_sy]])
     As = d2 * np.linalg.inv(kappa)
+    values = [p.area, p.ixx_c, p.iyy_c, p.ixy_c, p.j, p.x_se, p.y_se, *As.ravel()]
+    if not (np.all(np.isfinite(values)) and p.j > 0 and np.all(np.linalg.eigvalsh(As) > 0)):
+        raise ValueError(
+            f"the FE section analysis failed on {len(sec.elements)} triangles (J = {p.j:g}, "
+            "a singular warping system): try another mesh_size"
+        )
     return ShapeProperties(
         area=float(p.area),
         centroid=(float(p.cx), float(p.cy)),
