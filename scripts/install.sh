@@ -17,7 +17,7 @@ APT_PKGS=(
 )
 # openfast-io reads BeamDyn files (section type "beamdyn"); 4.2.1 is the last that reads the
 # BeamDyn v1.00 blade files of meshes/nrel5mw (5.0.0 expects a modal-damping block)
-PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib imageio ruff openfast-io)
+PIP_PKGS=("pytest>=8" pytest-xdist pytest-timeout pyvista matplotlib imageio ruff openfast-io sectionproperties)
 
 log() { printf '[install] %s\n' "$*"; }
 

@@ -8,10 +8,10 @@ import numpy as np
 
 from ..physics import sections
 from .expr import compile_expression, table_function
-from .sections import beamdyn_section, matrix_section, offsets, with_offsets
+from .sections import beamdyn_section, matrix_section, offsets, shape_section, with_offsets
 from .table import MAX_MAGNITUDE, Table, is_number
 
-SECTION_TYPES = ("rectangle", "circle", "tube", "general", "matrix", "beamdyn")
+SECTION_TYPES = ("rectangle", "circle", "tube", "general", "matrix", "beamdyn", "shape", "polygon")
 _SAMPLES = 201  # points along the beam where a varying value is checked
 _EXPRESSION_ERRORS = (ValueError, TypeError, ZeroDivisionError, FloatingPointError, OverflowError)
 
@@ -64,13 +64,15 @@ def along(t, key, length, default=..., positive=True):
 def read_section(t, mat, length, base=Path(".")):
     """A Section, or a SectionAlong if a value varies along the beam (``mat``: the
     material's (E, G, rho, nu) or None; ``length``: the beam's); a MatrixSection for the
-    types "matrix" and "beamdyn" (files relative to ``base``) or with offset keys
+    types "matrix", "beamdyn" (files relative to ``base``), "shape", "polygon" or with offset keys
     (:mod:`beamfx.scene.sections`)."""
     kind = t.get("type", str, choices=SECTION_TYPES)
     if kind == "matrix":
         return matrix_section(t, length)
     if kind == "beamdyn":
         return beamdyn_section(t, length, base)
+    if kind in ("shape", "polygon"):
+        return shape_section(t, mat, length)
     given = offsets(t)
     k = t.get("shear_factor", float, None, positive=True)
     value = partial(along, t, length=length)

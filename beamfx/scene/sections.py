@@ -4,7 +4,9 @@
 ``stations = [s/L, ...]`` with one matrix per station, and ``convention = "beamfx"`` (default)
 or ``"beamdyn"``; and the offset keys ``elastic_centre``, ``shear_centre`` and ``mass_centre``
 (``[y, z]`` in section axes) of a prismatic geometric or general section, which turn it into a
-matrix section (:mod:`beamfx.physics.matrix_sections`).
+matrix section (:mod:`beamfx.physics.matrix_sections`); ``type = "shape"`` (a built-in shape
+of sectionproperties) and ``type = "polygon"`` (``points``, ``holes``), analysed by
+:mod:`beamfx.physics.shape_sections` into a matrix section.
 """
 
 from numbers import Real
@@ -13,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..physics import matrix_sections as ms
+from ..physics import shape_sections as ss
 
 OFFSET_KEYS = ("elastic_centre", "shear_centre", "mass_centre")
 CONVENTIONS = ("beamfx", "beamdyn")
@@ -182,3 +185,113 @@ def read_twist(t, length):
     if not np.all(np.abs(samples) <= MAX_MAGNITUDE):
         t.fail("twist_deg", "must be finite along the whole beam")
     return f
+
+
+SHAPE_TYPES = ("shape", "polygon")
+REFERENCES = ("centroid", "shear_centre")
+
+
+def _points(t, key, value, what="points"):
+    ok = isinstance(value, list) and len(value) >= 3
+    ok = ok and all(
+        isinstance(p, list) and len(p) == 2 and all(map(_finite_number, p)) for p in value
+    )
+    if not ok:
+        t.fail(key, f"{what}: expected a list of at least 3 points [y, z] (finite numbers)")
+    return tuple((float(y), float(z)) for y, z in value)
+
+
+def _finite_number(v):
+    return isinstance(v, Real) and not isinstance(v, bool) and bool(np.isfinite(v))
+
+
+def _shape_params(t, name):
+    """The keyword arguments of the built-in shape ``name``, each checked (kind, sign)."""
+    params = {}
+    for key, (kind, required) in ss.shape_parameters(name).items():
+        if kind == "int":
+            value = t.get(key, int, ss.POINT_DEFAULTS.get(key, ...))
+            if value < 1:
+                t.fail(key, f"= {value}: must be a positive integer")
+        else:
+            value = t.get(key, float, ... if required else None, positive=kind == "length")
+            if value is None:
+                continue
+            if kind == "radius" and value < 0:
+                t.fail(key, f"= {value:g}: must be >= 0 (a radius)")
+        params[key] = value
+    return tuple(sorted(params.items()))
+
+
+def _shape_material(t, mat):
+    """(E, G, rho, nu) from the section table's own keys, else from ``mat`` ([material])."""
+    E0, G0, rho0, nu0 = mat if mat is not None else (None, None, 0.0, 0.3)
+    E = t.get("E", float, E0 if E0 is not None else ..., positive=True)
+    nu = t.get("nu", float, nu0)
+    if not -1 < nu < 0.5:
+        t.fail("nu", f"must lie in (-1, 0.5), got {nu}")
+    own = t.has("E") or t.has("nu")
+    G = t.get("G", float, E / (2 * (1 + nu)) if own or G0 is None else G0, positive=True)
+    rho = t.get("rho", float, rho0)
+    if not rho >= 0:
+        t.fail("rho", f"= {rho:g}: must be a finite number >= 0")
+    return E, G, rho, nu
+
+
+def _properties(t, kind):
+    """ShapeProperties of a shape or polygon table (computed once per distinct section; the
+    time of a new FE section solve is reported on stderr by rank 0)."""
+    mesh_size = t.get("mesh_size", float, None, positive=True)
+    key = "shape" if kind == "shape" else "points"
+    if kind == "shape":
+        name = t.get("shape", str, choices=ss.SHAPES)
+        args = (name, _shape_params(t, name))
+        solve = ss.shape_properties
+    else:
+        holes = t.get("holes", list, [])
+        holes = [_points(t, "holes", h, f"hole {i + 1}") for i, h in enumerate(holes)]
+        args = (_points(t, "points", t.get("points", list)), tuple(holes))
+        solve = ss.polygon_properties
+    return key, solve, args, mesh_size
+
+
+def shape_section(t, mat, length):
+    """The matrix section of a ``type = "shape"`` (a built-in shape of sectionproperties) or
+    ``type = "polygon"`` table (:mod:`beamfx.physics.shape_sections`), about its
+    ``reference`` point ("centroid", "shear_centre" or [y, z] of the shape's coordinates)."""
+    kind = t.get("type", str, choices=SHAPE_TYPES)
+    try:
+        import sectionproperties  # noqa: F401
+    except ImportError:
+        t.fail("type", f"{kind!r} needs the Python package sectionproperties (scripts/install.sh)")
+    key, solve, args, mesh_size = _properties(t, kind)
+    E, G, rho, nu = _shape_material(t, mat)
+    raw = t.data.get("reference", "centroid")
+    reference = raw if isinstance(raw, str) else _pair(t, "reference")
+    if isinstance(raw, str):
+        t.get("reference", str, "centroid", choices=REFERENCES)
+    t.done()
+    misses = solve.cache_info().misses
+    try:
+        props = solve(*args, nu, mesh_size)
+    except ValueError as e:
+        t.fail(key, str(e))
+    if solve.cache_info().misses > misses:
+        _report(t, props)
+    point = {"centroid": props.centroid, "shear_centre": props.shear_centre}.get(reference)
+    C, M = ss.shape_matrices(props, E, G, rho, reference if point is None else point)
+    return ms.MatrixSection(C[None], M[None], (0.0,), length)
+
+
+def _report(t, props):
+    import sys
+
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.rank == 0:
+        print(
+            f"beamfx: {t.where('type')}: FE section analysis of {props.elements} triangles "
+            f"in {props.seconds:.2f} s",
+            file=sys.stderr,
+            flush=True,
+        )

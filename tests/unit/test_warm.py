@@ -75,7 +75,7 @@ def test_folders_give_their_toml_files():
     sources = scene_sources([ROOT / "demos" / "scenes"], None)
     names = {s.path.name for s in sources}
     frames = {"dome.toml", "lattice.toml", "tower.toml"}
-    assert names == {"prestress_sweep.toml", "spin_up.toml"} | frames
+    assert names == {"prestress_sweep.toml", "spin_up.toml", "channel_cantilever.toml"} | frames
 
 
 def test_shortened_cuts_only_the_time_loop(tmp_path):
