@@ -194,12 +194,9 @@ def _context(scene, out, comm, log, restart, pictures):
     model = _build(scene, comm, log, scene.condense)
     log(f"model: {_trimming(scene, model)[0]}")
     if scene.condense:
-        per_node = 3 + model.kin.rotation_size
-        log(
-            "model: statically condensed (a cantilever under point loads): the rotations are "
-            f"the only unknowns, 3 per node instead of {per_node}, {model.unknowns()} instead of "
-            f"{model.unknowns() // 3 * per_node}; shear and stretch kept"
-        )
+        from .analyses.trimming import condensing_summary
+
+        log(f"model: {condensing_summary(model.kin, model.unknowns())[0]}")
     output = scene.output
     if output.every is None and output.times is None:  # the analysis's default interval
         output = replace(output, every=getattr(scene.settings, "frames_every", 1))
@@ -246,7 +243,15 @@ def _model_entry(scene, ctx):
         "stretch": kin.stretch,
         "trimming": _trimming(scene, model)[1],
         "condensed": bool(scene.condense and ctx.rebuild is not None),
+        **({"condensing": _condensing(ctx)} if scene.condense and ctx.rebuild else {}),
     }
+
+
+def _condensing(ctx):
+    """The ``condensing`` entry of results.json: which condensed model solved, and why."""
+    from .analyses.trimming import condensing_summary
+
+    return condensing_summary(ctx.model.kin, ctx.model.unknowns())[1]
 
 
 def _reactions(ctx):

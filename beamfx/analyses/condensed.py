@@ -41,17 +41,23 @@ class RotationRangeError(ValueError):
     """A rotation beyond :data:`MAX_ANGLE` in the condensed model."""
 
 
-#: moment kinds with a local virtual work in g
-
-
 def build_model(model, comm, extra_points=(), condense=False):
-    """The :class:`CondensedModel` of ``model`` if ``condense``, else its
-    :class:`~beamfx.analyses.model.BeamModel`."""
-    return (CondensedModel if condense else BeamModel)(model, comm, extra_points=extra_points)
+    """The statically condensed model of ``model`` if ``condense`` (the
+    :class:`~beamfx.analyses.planar_condensed.PlanarCondensedModel` of a planar model, else
+    the :class:`CondensedModel`), else its :class:`~beamfx.analyses.model.BeamModel`."""
+    if not condense:
+        return BeamModel(model, comm, extra_points=extra_points)
+    if model.kinematics.plane:
+        from .planar_condensed import PlanarCondensedModel
+
+        return PlanarCondensedModel(model, comm, extra_points=extra_points)
+    return CondensedModel(model, comm, extra_points=extra_points)
 
 
 class FollowerCoupling:
-    """The follower forces' rank-3 tangent terms and their values from the current rotations."""
+    """The follower forces' tangent terms (rank 3 with a rotation vector, rank 1 with a plane
+    angle) and their values from the current rotations; ``model.np_rotation`` maps the
+    rotation unknowns at a node to the rotation matrix."""
 
     def __init__(self, model, forces):
         import dolfinx.fem.petsc  # noqa: F401  (fem.petsc)
@@ -60,14 +66,16 @@ class FollowerCoupling:
         self.model, self.forces = model, forces  # [(Constant F, f0, point, G forms)]
         self.G = [[fem.petsc.create_vector(G_i) for G_i in f[3]] for f in forces]
         V = model.W
+        self.bs = bs = V.dofmap.index_map_bs  # rotation unknowns per node: 3 or 1
         self._bc_dofs = constrained_dofs(model.bcs)
         owned = owned_size(V)
         self._rows = np.arange(owned, dtype=np.int32)
-        self._rows_global = V.dofmap.index_map.local_range[0] * 3 + self._rows
+        self._rows_global = V.dofmap.index_map.local_range[0] * bs + self._rows
         self._tip = [self._point_dofs(f[2]) for f in forces]
 
     def _point_dofs(self, at):
-        """Global indices of the three dofs of g at a named point (every rank)."""
+        """Global indices of the dofs of g at a named point (every rank), and the local ones
+        on the rank that owns them (else None)."""
         from dolfinx import fem
 
         m, V = self.model.mesh.mesh, self.model.W
@@ -75,20 +83,21 @@ class FollowerCoupling:
         local = fem.locate_dofs_topological(V, 0, verts)
         owned = [d for d in local if d < V.dofmap.index_map.size_local]
         start = V.dofmap.index_map.local_range[0]
-        mine = [(start + d) * 3 + np.arange(3) for d in owned[:1]]
+        bs = self.bs
+        mine = [(start + d) * bs + np.arange(bs) for d in owned[:1]]
         found = [x for part in m.comm.allgather(mine) for x in part]
-        return found[0].astype(np.int32), (owned[0] * 3 + np.arange(3)) if owned else None
+        return found[0].astype(np.int32), (owned[0] * bs + np.arange(bs)) if owned else None
 
     def _g_at(self, dofs):
         """The rotation vector at a point, from the rank that owns it (collective)."""
         local = dofs[1]
-        g = self.model.w.x.array[local] if local is not None else np.zeros(3)
+        g = self.model.w.x.array[local] if local is not None else np.zeros(self.bs)
         return self.model.comm.allreduce(g, op=MPI.SUM)
 
     def update(self):
         """F = R(g_a) f0 into the constants, from the current rotations."""
         for (F, f0, _, _), dofs in zip(self.forces, self._tip):
-            F.value[:] = np_exp_rotation(self._g_at(dofs)) @ f0
+            F.value[:] = self.model.np_rotation(self._g_at(dofs)) @ f0
 
     def reset(self):
         """Put the reference forces f0 back into the constants (the undeformed state)."""
@@ -103,7 +112,7 @@ class FollowerCoupling:
         lam = float(self.model.load_factor.value)
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         for (_, f0, _, forms), G, dofs in zip(self.forces, self.G, self._tip):
-            dF = self._force_derivative(f0, self._g_at(dofs))  # (3 components, 3 dofs)
+            dF = self._force_derivative(f0, self._g_at(dofs))  # (3 components, bs dofs)
             rows = []
             for vec, form in zip(G, forms):
                 with vec.localForm() as local:
@@ -116,14 +125,14 @@ class FollowerCoupling:
             A.setValues(self._rows_global, dofs[0], -lam * G_local @ dF, addv=True)
         A.assemble()
 
-    @staticmethod
-    def _force_derivative(f0, g, h=1e-7):
-        """∂(exp(ĝ) f0)/∂g by central differences (3 × 3; R is smooth in g)."""
-        out = np.zeros((3, 3))
-        for j in range(3):
-            e = np.zeros(3)
+    def _force_derivative(self, f0, g, h=1e-7):
+        """∂(R(g) f0)/∂g by central differences (3 × bs; R is smooth in g)."""
+        rotate = self.model.np_rotation
+        out = np.zeros((3, len(g)))
+        for j in range(len(g)):
+            e = np.zeros(len(g))
             e[j] = h
-            out[:, j] = (np_exp_rotation(g + e) - np_exp_rotation(g - e)) @ f0
+            out[:, j] = (rotate(g + e) - rotate(g - e)) @ f0
         return out / (2 * h)
 
     def destroy(self):
@@ -138,7 +147,15 @@ class CondensedModel(Discretised):
     doc): a :class:`~beamfx.analyses.formulation.Formulation` whose unknown ``w`` is the
     rotation vector field g on ``W`` (P_k, 3 components), plus ``u`` (the displacement, derived
     by :meth:`sync`) and ``coupling`` (the follower forces' tangent terms, or None).
+
+    The rotation parametrisation is in the hooks :meth:`_space`, :meth:`rotation_of`,
+    :meth:`quaternion_of`, :meth:`curvature_of`, :meth:`_moment_work` and :meth:`np_rotation`;
+    :class:`~beamfx.analyses.planar_condensed.PlanarCondensedModel` overrides them with the
+    plane angle.
     """
+
+    #: name of the unknown field
+    field_name = "rotation_vector"
 
     def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=()):
         from dolfinx import fem
@@ -147,7 +164,7 @@ class CondensedModel(Discretised):
         why = condensed_fit(model)
         if why:
             raise ValueError(f"the statically condensed model does not apply: {why}")
-        # finite, spatial kinematics (condensed_fit); shear and stretch decide the compliance
+        # finite kinematics (condensed_fit); shear and stretch decide the compliance
         self.spec, self.kin = model, model.kinematics
         self.discretisation = d = discretise(model, comm, extra_points)
         m, p = d.mesh.mesh, d.degree
@@ -159,16 +176,62 @@ class CondensedModel(Discretised):
                 + [1 / C[i] if kin.shear else 0.0 for i in (1, 2)]
             )
         )
-        self.W = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
-        self.w = fem.Function(self.W, name="rotation_vector")
-        self.u = fem.Function(self.W, name="displacement")  # derived: :meth:`sync`
+        # the cells' vertex 0 -> 1 direction against increasing arc length (DOLFINx may
+        # reverse a cell): t_s = ±t0 is the tangent d/ds, for the terms linear in it
+        s_ends = d.cell_arc_lengths([0.0, 1.0])
+        self._flipped = s_ends[:, 0] > s_ends[:, 1]
+        self.t_s = d.cell_function(np.where(self._flipped, -1.0, 1.0)) * d.t0
+        self.W = self._space(m, p)
+        self.w = fem.Function(self.W, name=self.field_name)
+        U = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
+        self.u = fem.Function(U, name="displacement")  # derived: :meth:`sync`
         self.dx = ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p + 2})
         self._build_forms()
         verts = self.mesh.point_tags.find(self.mesh.points[model.supports[0].at][0])
         clamp = fem.locate_dofs_topological(self.W, 0, verts)
-        self.bcs = [fem.dirichletbc(np.zeros(3), clamp, self.W)]
+        bs = self.W.dofmap.index_map_bs
+        zero = np.zeros(bs) if bs > 1 else PETSc.ScalarType(0.0)
+        self.bcs = [fem.dirichletbc(zero, clamp, self.W)]
         self.coupling = FollowerCoupling(self, self._followers) if self._followers else None
         self._integrator = None
+
+    # --- the rotation parametrisation (hooks) -----------------------------------------------
+
+    def _space(self, m, p):
+        """The space of the unknowns: the rotation vector, P_p, 3 components."""
+        from dolfinx import fem
+
+        return fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
+
+    def quaternion_of(self, g):
+        """Unit quaternion (UFL) of the unknowns ``g``."""
+        return rod.rotation_quaternion(g)
+
+    def rotation_of(self, g):
+        """Rotation matrix R (UFL) of the unknowns ``g``."""
+        from ..physics.rotations import rotation
+
+        return rotation(rod.rotation_quaternion(g))
+
+    def curvature_of(self, g):
+        """K = Λ0ᵀ axial(Rᵀ R') (section axes) of the unknowns ``g``."""
+        d = self.discretisation
+        return rod.curvature(g, d.t0, d.Lam0)
+
+    @staticmethod
+    def np_rotation(g):
+        """Rotation matrix of the unknowns at one node (NumPy): exp(ĝ)."""
+        return np_exp_rotation(g)
+
+    def _moment_work(self, ld, g, v):
+        M = ufl.as_vector([float(c) for c in ld.moment])
+        if ld.kind == "semitangential":
+            from ..physics.rotations import quaternion_rotation_vector
+
+            return ufl.derivative(
+                ufl.dot(M, quaternion_rotation_vector(rod.rotation_quaternion(g))), g, v
+            )
+        return ufl.dot(M, rod.virtual_rotation(g, v, spatial=ld.kind == "dead"))
 
     # --- forms ------------------------------------------------------------------------------
 
@@ -200,14 +263,16 @@ class CondensedModel(Discretised):
             if any(ld.moment):
                 moments += d.at_point(ld.at, self._moment_work(ld, g, v))
         n = self.load_factor * self.section_force()
-        Pi = rod.bending_energy(g, d.t0, d.Lam0, d.C_M, self.dx) - rod.load_potential(
-            g, n, d.t0, d.Lam0, self.compliance, self.dx
+        R = self.rotation_of(g)
+        K = self.curvature_of(g)
+        Pi = rod.bending_energy(K, d.C_M, self.dx) - rod.load_potential(
+            R, n, self.t_s, d.Lam0, self.compliance, self.dx
         )
         self.F = ufl.derivative(Pi, g, v) - self.load_factor * moments
         self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.W))
         self.work = None  # the residual is not linear in the load factor (arc length: no)
-        self.x_dot = rod.position_rate(g, n, d.t0, d.Lam0, self.compliance)
-        # follower forces: ∂(residual)/∂(force at the point), for the tangent's rank-3 term
+        self.x_dot = rod.position_rate(R, n, self.t_s, d.Lam0, self.compliance)
+        # follower forces: ∂(residual)/∂(force at the point), for the tangent's coupling term
         self._followers = [
             (
                 F,
@@ -217,16 +282,6 @@ class CondensedModel(Discretised):
             )
             for F, f0, at, before in followers
         ]
-
-    def _moment_work(self, ld, g, v):
-        M = ufl.as_vector([float(c) for c in ld.moment])
-        if ld.kind == "semitangential":
-            from ..physics.rotations import quaternion_rotation_vector
-
-            return ufl.derivative(
-                ufl.dot(M, quaternion_rotation_vector(rod.rotation_quaternion(g))), g, v
-            )
-        return ufl.dot(M, rod.virtual_rotation(g, v, spatial=ld.kind == "dead"))
 
     # --- state ------------------------------------------------------------------------------
 
@@ -242,7 +297,7 @@ class CondensedModel(Discretised):
         self.load_factor.value = lam
 
     def unknowns(self):
-        """Global number of unknowns (three per node)."""
+        """Global number of unknowns (rotation components per node times the nodes)."""
         return global_size(self.W)
 
     def largest_angle(self):
@@ -269,43 +324,58 @@ class CondensedModel(Discretised):
 
     def section_parts(self):
         """(X, u, quaternion, Λ0, N, M) as UFL, for :func:`beamfx.io._sections.section_expression`."""
-        from ..physics.rotations import rotation
-
         d, g = self.discretisation, self.w
-        R = rotation(rod.rotation_quaternion(g))
+        R = self.rotation_of(g)
         N = d.Lam0.T * (R.T * (self.load_factor * self.section_force()))
-        M = d.C_M * rod.curvature(g, d.t0, d.Lam0)
+        M = d.C_M * self.curvature_of(g)
         X = ufl.SpatialCoordinate(self.mesh.mesh)
-        return X, self.u, rod.rotation_quaternion(g), d.Lam0, N, M
+        return X, self.u, self.quaternion_of(g), d.Lam0, N, M
 
-    def sync(self):
-        """Integrate the displacement u = ∫ (x' − t0) ds from the clamp into ``self.u``.
+    def _increments(self, xi):
+        """u(node) − u(vertex 0) of each local cell's nodes (n_cells, len(xi), 3)."""
+        return self._quadrature_increments(xi)
 
-        Each node's u is the value at its cell's vertex 0 plus ∫₀^ξ u_ξ dξ (Gauss, p + 2
-        points), the vertex values chained from the clamp along the beam.
-        Collective: the per-cell increments of all ranks are allgathered (few cells).
-        """
+    def _quadrature_increments(self, xi, subintervals=1):
+        """:meth:`_increments` by Gauss quadrature of u_ξ = ±|J| (x' − t_s) from vertex 0 to
+        each node ξ_j: ``subintervals`` equal parts of [0, ξ_j], p + 2 points in each (one
+        expression compiled per count, cached)."""
         from dolfinx import fem
 
         from ..solvers.forms import JIT_PARAMS
 
-        V, m = self.W, self.mesh.mesh
-        xi = np.asarray(V.element.interpolation_points()).reshape(-1)  # node order of a cell
-        if self._integrator is None:
+        m = self.mesh.mesh
+        cache = self._integrator = self._integrator or {}
+        if subintervals not in cache:
             gx, gw = np.polynomial.legendre.leggauss(self.degree + 2)
-            points = (xi[:, None] * (gx[None, :] + 1) / 2).reshape(-1, 1)
-            x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| u'
-            u_xi = ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.discretisation.t0)
+            local = ((np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals)
+            points = (xi[:, None] * local.ravel()[None, :]).reshape(-1, 1)
+            x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| (t0·t_s) u'
+            sign = ufl.dot(self.t_s, self.discretisation.t0)
+            u_xi = sign * ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.t_s)
             expr = fem.Expression(u_xi, points, jit_params=dict(JIT_PARAMS))
-            # arc length at vertex 0 and 1 of each cell
-            s_ends = self.discretisation.cell_arc_lengths([0.0, 1.0])
-            self._integrator = (expr, gw / 2, s_ends)
-        expr, gw, s_ends = self._integrator
+            weights = np.tile(gw / 2, subintervals) / subintervals
+            cache[subintervals] = (expr, weights)
+        expr, gw = cache[subintervals]
         n = m.topology.index_map(1).size_local
         vals = expr.eval(np.arange(n, dtype=np.int32)).reshape(n, len(xi), len(gw), 3)
-        inc = xi[None, :, None] * np.einsum("cngi,g->cni", vals, gw)  # vertex 0 -> each node
+        return xi[None, :, None] * np.einsum("cngi,g->cni", vals, gw)
+
+    def sync(self):
+        """Integrate the displacement u = ∫ (x' − t0) ds from the clamp into ``self.u``.
+
+        Each node's u is the value at its cell's vertex 0 plus the cell's increment to it
+        (:meth:`_increments`), the vertex values chained from the clamp along the beam.
+        Collective: the per-cell increments of all ranks are allgathered (few cells).
+        """
+        V, m = self.u.function_space, self.mesh.mesh
+        xi = np.asarray(V.element.interpolation_points()).reshape(-1)  # node order of a cell
+        if self.coupling:  # follower forces from the converged rotations
+            self.coupling.update()
+        inc = self._increments(xi)
+        n = m.topology.index_map(1).size_local
+        s_ends = self.discretisation.cell_arc_lengths([0.0, 1.0])
         s_a = s_ends[:n].min(axis=1)
-        flipped = s_ends[:n, 0] > s_ends[:n, 1]  # DOLFINx reversed the cell
+        flipped = self._flipped[:n]
         one = int(np.argmin(np.abs(xi - 1.0)))  # the node at vertex 1
         step = np.where(flipped[:, None], -inc[:, one], inc[:, one])  # from s_a to s_b
         parts = self.comm.allgather((s_a, step))

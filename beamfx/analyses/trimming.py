@@ -187,14 +187,17 @@ MOMENT_KINDS = ("dead", "follower", "semitangential")
 
 
 def condensed_fit(model, analysis="static"):
-    """None if the condensed model applies to ``model`` and ``analysis``, else why not."""
+    """None if the condensed model applies to ``model`` and ``analysis``, else why not.
+
+    It applies to planar and spatial models alike: a planar model (``kinematics.plane``, as
+    :func:`choose_plane` set it) is condensed to the plane angle, one unknown per node
+    (:mod:`beamfx.analyses.planar_condensed`), a spatial one to the rotation vector, three.
+    """
     kin = model.kinematics
     if analysis != "static":
         return f"it solves static analyses only, not {analysis!r}"
     if not kin.finite:
         return "the kinematics are linear (one linear solve already)"
-    if kin.plane:
-        return "the planar model has as few unknowns per node"
     if len(model.beams) != 1:
         return "it models one beam"
     if len(model.supports) != 1:
@@ -218,6 +221,33 @@ def condensed_fit(model, analysis="static"):
     return None
 
 
+def condensing_summary(kin, unknowns):
+    """Log line and results entry of a condensed model of kinematics ``kin`` with
+    ``unknowns`` unknowns: which one (planar: the angle, 1 per node; spatial: the rotation
+    vector, 3 per node), the unknowns of the model it replaces, and why it applies."""
+    per_node, full = (1, 3) if kin.plane else (3, 3 + kin.rotation_size)
+    nodes = unknowns // per_node
+    name = "planar statically condensed" if kin.plane else "statically condensed"
+    field = f"the angle about the plane's normal ({kin.plane})" if kin.plane else "the rotations"
+    kept = ", ".join(
+        [w for w, on in (("shear", kin.shear), ("stretch", kin.stretch)) if on]
+    ) or "neither shear nor stretch"
+    line = (
+        f"{name} (a cantilever under point loads: the section force is known): {field} the "
+        f"only unknown, {per_node} per node instead of {full}, {unknowns} instead of "
+        f"{nodes * full}; {kept} kept"
+        + ("; any number of turns" if kin.plane else "")
+    )
+    entry = {
+        "model": "planar_condensed" if kin.plane else "condensed",
+        "unknowns": unknowns,
+        "unknowns_replaced_model": nodes * full,
+        "per_node": (per_node, full),
+        "reason": "a static cantilever under point loads (condensed_fit)",
+    }
+    return line, entry
+
+
 __all__ = [
     "MOMENT_KINDS",
     "NEVER_TRIMMED",
@@ -225,6 +255,7 @@ __all__ = [
     "Trim",
     "choose_plane",
     "condensed_fit",
+    "condensing_summary",
     "plane_fit",
     "trimming_summary",
 ]

@@ -11,10 +11,17 @@ The rotation is parametrised by the rotation vector ψ, R = exp(ψ̂) through th
 (cos(θ/2), sin(θ/2) ψ/θ), θ = |ψ| (a series near θ = 0): a plane bending field is linear in
 s, so polynomials represent a roll-up well; valid for angles below 2π, where the map from ψ
 to R is singular (:data:`~beamfx.analyses.condensed.MAX_ANGLE`).
+
+In a plane problem the rotation is R(θ) about the plane's normal n (:func:`plane_rotation`)
+and the angle θ(s) is the only unknown, one per node, valid at any angle: the curvature is
+K = Λ0ᵀ n θ' (:func:`plane_curvature`), linear in θ, so a pure end moment (n = 0) leaves the
+quadratic energy ½ EI θ'² − M θ(L), whose Galerkin solution on P_k (k ≥ 1) is the exact
+θ = M s / EI. The functions below take the rotation matrix R, so that both parametrisations
+share them.
 """
 
 from .kinematics import d_ds
-from .rotations import body_rate, rotation, spatial_rate
+from .rotations import body_rate, spatial_rate
 
 
 def rotation_quaternion(psi):
@@ -48,19 +55,36 @@ def virtual_rotation(g, dg, spatial=True):
     return spatial_rate(q, dq) if spatial else body_rate(q, dq)
 
 
-def section_strains(g, n, Lam0, compliance):
-    """Γ = C_N⁻¹ Λ0ᵀ Rᵀ n: the strains that the section force n (global axes) causes."""
-    return compliance * (Lam0.T * (rotation(rotation_quaternion(g)).T * n))
+def plane_rotation(theta, normal):
+    """R(θ) = I + sin θ N + (1 − cos θ) N², N = hat(normal): the rotation by the angle θ about
+    the plane's unit normal (global axes), valid at any angle (no 2π limit)."""
+    import ufl
+
+    from .rotations import hat
+
+    N = hat(normal)
+    return ufl.Identity(3) + ufl.sin(theta) * N + (1 - ufl.cos(theta)) * N * N
 
 
-def position_rate(g, n, t0, Lam0, compliance):
+def plane_curvature(theta, normal, t0, Lam0):
+    """K = Λ0ᵀ n θ' (section axes): axial(RᵀR') = n θ' for a rotation about a fixed n."""
+    return Lam0.T * normal * d_ds(theta, t0)
+
+
+def section_strains(R, n, Lam0, compliance):
+    """Γ = C_N⁻¹ Λ0ᵀ Rᵀ n: the strains that the section force n (global axes) causes in the
+    section rotated by R."""
+    return compliance * (Lam0.T * (R.T * n))
+
+
+def position_rate(R, n, t0, Lam0, compliance):
     """Centre-line tangent x' = R (t0 + Λ0 Γ) with Γ from the section force ``n``."""
-    R = rotation(rotation_quaternion(g))
-    return R * (t0 + Lam0 * section_strains(g, n, Lam0, compliance))
+    return R * (t0 + Lam0 * section_strains(R, n, Lam0, compliance))
 
 
-def load_potential(g, n, t0, Lam0, compliance, dx):
-    r"""∫ n·(R − I) t0 ds + ½ ∫ Γ·C_N Γ ds with Γ = C_N⁻¹ Λ0ᵀ Rᵀ n.
+def load_potential(R, n, t0, Lam0, compliance, dx):
+    r"""∫ n·(R − I) t0 ds + ½ ∫ Γ·C_N Γ ds with Γ = C_N⁻¹ Λ0ᵀ Rᵀ n; ``R`` the rotation field
+    (UFL matrix, of the rotation vector or of the plane angle).
 
     For a statically determinate beam (a cantilever under point forces) n(s) is the sum of
     the forces beyond s. The Simo–Reissner energy ½ K·C_M K + ½ Γ·C_N Γ − Σ F·u(s_a), with
@@ -71,14 +95,13 @@ def load_potential(g, n, t0, Lam0, compliance, dx):
     """
     import ufl
 
-    Gamma = section_strains(g, n, Lam0, compliance)
-    R = rotation(rotation_quaternion(g))
+    Gamma = section_strains(R, n, Lam0, compliance)
     return (ufl.dot(n, (R - ufl.Identity(3)) * t0) + 0.5 * ufl.dot(Gamma, Lam0.T * (R.T * n))) * dx
 
 
-def bending_energy(g, t0, Lam0, C_M, dx):
-    """½ K·C_M K: the whole strain energy of the Kirchhoff rod."""
+def bending_energy(K, C_M, dx):
+    """½ K·C_M K of the curvature K (section axes): the whole strain energy of the Kirchhoff
+    rod."""
     import ufl
 
-    K = curvature(g, t0, Lam0)
     return 0.5 * ufl.dot(K, C_M * K) * dx

@@ -1,0 +1,189 @@
+r"""The planar statically condensed beam: the in-plane angle θ(s) is the only unknown.
+
+A cantilever under point loads that is also a plane problem
+(:func:`~beamfx.analyses.trimming.choose_plane` and
+:func:`~beamfx.analyses.trimming.condensed_fit` both hold) turns about the plane's normal n
+only: R(θ) = exp(θ n̂) (:func:`~beamfx.physics.condensed.plane_rotation`). The strains are
+eliminated from the known section force exactly as in the spatial condensed model
+(:mod:`beamfx.analyses.condensed`), Γ = C_N⁻¹ Λ0ᵀ Rᵀ n, with shear and stretch kept (or
+dropped with ``[model] shear``/``stretch`` false), so one scalar per node is left, and the
+angle has no range limit: any number of turns.
+
+The curvature K = Λ0ᵀ n θ' is linear in θ. Under a pure end moment (n = 0) the energy is
+½ EI θ'² − M θ(L), whose Galerkin solution on P_k is the exact θ = M s/EI for every k ≥ 1:
+one P1 element rolls a beam up into any number of turns. The centre line
+x' = R(θ)(t_s + Λ0 Γ) is then integrated cell by cell in closed form (:func:`chord_increments`)
+where θ is linear in a cell (P1, straight cells, sections constant in the cell), so the
+roll-up is exact to round-off; otherwise by composite Gauss quadrature with the cell split
+until θ turns by at most :data:`SUBINTERVAL_ANGLE` in a part.
+"""
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from ..physics import condensed as rod
+from ..physics.kinematics import PLANES, plane_normal
+from .condensed import CondensedModel
+
+#: largest turn of θ in one part of a cell in the quadrature of the centre line (radians):
+#: p + 2 Gauss points per part then integrate cos θ and sin θ to about 1e-16
+SUBINTERVAL_ANGLE = 0.25
+
+
+def plane_complex(v, plane):
+    """In-plane components of global vectors ``v`` (..., 3) as complex numbers v_a + i v_b
+    (a, b the plane's axes, a × b = n): a rotation by θ about n is then e^{iθ}."""
+    a, b, _ = PLANES[plane]
+    return v[..., a] + 1j * v[..., b]
+
+
+def _integral_exp(theta0, delta):
+    """∫₀¹ e^{i(θ0 + Δ ξ)} dξ = e^{i(θ0 + Δ/2)} sin(Δ/2)/(Δ/2) (the Δ → 0 limit 1 exact)."""
+    return np.exp(1j * (theta0 + delta / 2)) * np.sinc(delta / (2 * np.pi))
+
+
+def chord_increments(theta0, theta1, chord, h, sign, A, n):
+    r"""u(ξ = 1) − u(ξ = 0) of straight cells with θ linear in ξ, all in plane complex numbers.
+
+    x_ξ = R(θ) c + σ h R A Rᵀ n, c the cell's chord (vertex 0 → 1), h its length, σ = ±1
+    (is ξ the arc length's direction), A = Λ0 C_N⁻¹ Λ0ᵀ and n the section force, constant in
+    the cell. With A = α I + D (D symmetric, traceless: D v = δ v̄, δ = D_aa + i D_ab),
+    R D Rᵀ n = δ n̄ e^{2iθ}, so
+
+        Δu = c (∫e^{iθ} − 1) + σ h (α n + δ n̄ ∫e^{2iθ}),
+
+    both integrals closed form (:func:`_integral_exp`). Arguments are arrays over the cells;
+    ``chord`` and ``n`` complex (:func:`plane_complex`), ``A`` (n_cells, 2, 2), the in-plane
+    block.
+    """
+    alpha = 0.5 * (A[:, 0, 0] + A[:, 1, 1])
+    delta = 0.5 * (A[:, 0, 0] - A[:, 1, 1]) + 1j * A[:, 0, 1]
+    bend = chord * (_integral_exp(theta0, theta1 - theta0) - 1)
+    turn = _integral_exp(2 * theta0, 2 * (theta1 - theta0))
+    strain = sign * h * (alpha * n + delta * np.conj(n) * turn)
+    return bend + strain
+
+
+class PlanarCondensedModel(CondensedModel):
+    """The statically condensed beam of a planar :class:`~beamfx.spec.Model`
+    (``kinematics.plane`` set): ``w`` is the angle θ about the plane's normal on ``W`` (P_k,
+    scalar), ``u`` the displacement (global axes, derived by :meth:`sync`). See the module
+    doc."""
+
+    field_name = "rotation_angle"
+
+    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=()):
+        if not model.kinematics.plane:
+            raise ValueError("the planar condensed model needs a planar model (kinematics.plane)")
+        self.normal = plane_normal(model.kinematics)
+        self._n = np.eye(3)[PLANES[model.kinematics.plane][2]]
+        self._cell_data = None
+        super().__init__(model, comm, extra_points)
+
+    # --- the rotation parametrisation -------------------------------------------------------
+
+    def _space(self, m, p):
+        """The space of the unknowns: the angle, P_p, scalar."""
+        from dolfinx import fem
+
+        return fem.FunctionSpace(m, ufl.FiniteElement("Lagrange", m.ufl_cell(), p))
+
+    def quaternion_of(self, g):
+        """(cos θ/2, sin θ/2 n): the unit quaternion of the rotation by θ about n."""
+        n = self.normal
+        return ufl.as_vector([ufl.cos(g / 2)] + [ufl.sin(g / 2) * n[i] for i in range(3)])
+
+    def rotation_of(self, g):
+        """R(θ) about the plane's normal (:func:`~beamfx.physics.condensed.plane_rotation`)."""
+        return rod.plane_rotation(g, self.normal)
+
+    def curvature_of(self, g):
+        """K = Λ0ᵀ n θ' (section axes)."""
+        d = self.discretisation
+        return rod.plane_curvature(g, self.normal, d.t0, d.Lam0)
+
+    def np_rotation(self, g):
+        """Rotation matrix by the angle g[0] about the plane's normal (NumPy)."""
+        from ..physics.rotations import np_exp_rotation
+
+        return np_exp_rotation(float(g[0]) * self._n)
+
+    def _moment_work(self, ld, g, v):
+        """M·n δθ: a moment normal to the plane (choose_plane) works the same dead, follower or
+        semitangential, since R n = n."""
+        return float(np.dot(ld.moment, self._n)) * v
+
+    # --- state ------------------------------------------------------------------------------
+
+    def largest_angle(self):
+        """Largest nodal |θ| (no limit applies: the angle is valid at any size)."""
+        local = float(np.abs(self.w.x.array).max(initial=0.0))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
+    def check_state(self):
+        """Nothing to check: R(θ) is valid at any angle."""
+
+    # --- output -----------------------------------------------------------------------------
+
+    def closed_form(self):
+        """Whether :meth:`sync` integrates the centre line in closed form: P1 (straight cells,
+        θ linear) and every section field constant in a cell."""
+        d = self.discretisation
+        constant = all(
+            f.function_space.ufl_element().degree() == 0 for f in (d.stiffness, d.twist)
+        )
+        return self.degree == 1 and constant
+
+    def _data(self):
+        """Per local cell: its cells' indices, chord (3), σ, the in-plane block of
+        A = Λ0 C_N⁻¹ Λ0ᵀ (2 × 2) at the midpoint and the expression of the section force n
+        there (None without forces)."""
+        from dolfinx import fem
+
+        from ..solvers.forms import JIT_PARAMS
+
+        d, m = self.discretisation, self.mesh.mesh
+        if self._cell_data is None:
+            A = d.Lam0 * self.compliance * d.Lam0.T
+            a, b, _ = PLANES[self.kin.plane]
+            values = ufl.as_vector([A[a, a], A[a, b], A[b, b]])
+            statics = fem.Expression(values, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
+            force = None  # no forces: n = 0 (and no expression with no domain to compile)
+            if self._forces:
+                n = self.load_factor * self.section_force()
+                force = fem.Expression(n, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
+            cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
+            nodes = m.geometry.dofmap.array.reshape(-1, 2)[: len(cells)]
+            chord = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]
+            AA = statics.eval(cells).reshape(-1, 3)
+            block = np.stack([AA[:, [0, 1]], AA[:, [1, 2]]], axis=1)
+            sign = np.where(self._flipped[: len(cells)], -1.0, 1.0)
+            self._cell_data = (cells, chord, sign, block, force)
+        return self._cell_data
+
+    def _increments(self, xi):
+        """u(node) − u(vertex 0) per local cell: closed form where θ is linear in a straight
+        cell (:meth:`closed_form`), else composite Gauss with parts of at most
+        :data:`SUBINTERVAL_ANGLE` of turn."""
+        n_cells = self.mesh.mesh.topology.index_map(1).size_local
+        theta = self.w.x.array[self.W.dofmap.list.array.reshape(-1, len(xi))[:n_cells]]
+        if not self.closed_form():
+            turn = float(np.ptp(theta, axis=1).max(initial=0.0)) if n_cells else 0.0
+            turn = self.comm.allreduce(turn, op=MPI.MAX)
+            parts = 2 ** int(np.ceil(np.log2(max(1.0, turn / SUBINTERVAL_ANGLE))))
+            return self._quadrature_increments(xi, parts)
+        cells, chord, sign, block, force = self._data()
+        n_global = force.eval(cells).reshape(-1, 3) if force else np.zeros((len(cells), 3))
+        n = plane_complex(n_global, self.kin.plane)
+        c = plane_complex(chord, self.kin.plane)
+        h = np.linalg.norm(chord, axis=1)
+        i0, i1 = int(np.argmin(xi)), int(np.argmax(xi))
+        du = chord_increments(theta[:, i0], theta[:, i1], c, h, sign, block, n)
+        a, b, _ = PLANES[self.kin.plane]
+        inc = np.zeros((n_cells, len(xi), 3))
+        inc[:, i1, a], inc[:, i1, b] = du.real, du.imag
+        return inc
+
+
+__all__ = ["PlanarCondensedModel", "chord_increments", "plane_complex"]
