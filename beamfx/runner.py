@@ -171,7 +171,7 @@ def _refine(scene, comm, log):
 
 def _build(scene, comm, log, condense):
     """The model the scene asks for (condensed where the builder chose it), logged."""
-    from .analyses.condensed import build_model
+    from .analyses.planar_condensed import build_model
 
     points = [*scene.probes.values(), *getattr(scene.settings, "points", lambda: ())()]
     model = build_model(scene.model, comm, points, condense)
@@ -192,7 +192,7 @@ def _context(scene, out, comm, log, restart, pictures):
     from .io.output import FrameWriter
 
     model = _build(scene, comm, log, scene.condense)
-    log(f"model: {_trimming(scene, model)[0]}")
+    log(f"model: {_trimming(scene, model, scene.condense)[0]}")
     if scene.condense:
         from .analyses.trimming import condensing_summary
 
@@ -222,17 +222,18 @@ def _context(scene, out, comm, log, restart, pictures):
     )
 
 
-def _trimming(scene, model):
+def _trimming(scene, model, condensed):
     """(log line, results entry) of the model the scene builder chose for ``model``."""
     from .analyses.trimming import Trim, trimming_summary
 
     trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
-    return trimming_summary(trim, model.kin, model.unknowns())
+    return trimming_summary(trim, model.kin, model.unknowns(), bool(condensed))
 
 
 def _model_entry(scene, ctx):
     """The ``model`` entry of results.json: what was solved."""
     model, kin = ctx.model, ctx.model.kin
+    condensed = bool(scene.condense and ctx.rebuild is not None)  # not after a fallback
     return {
         "beams": [b.name for b in scene.model.beams],
         "degree": model.degree,
@@ -241,9 +242,9 @@ def _model_entry(scene, ctx):
         "plane": kin.plane,
         "shear": kin.shear,
         "stretch": kin.stretch,
-        "trimming": _trimming(scene, model)[1],
-        "condensed": bool(scene.condense and ctx.rebuild is not None),
-        **({"condensing": _condensing(ctx)} if scene.condense and ctx.rebuild else {}),
+        "trimming": _trimming(scene, model, condensed)[1],
+        "condensed": condensed,
+        **({"condensing": _condensing(ctx)} if condensed else {}),
     }
 
 

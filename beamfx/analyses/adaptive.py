@@ -107,7 +107,7 @@ def _quantity(values, what):
 def solve_once(model_spec, scene, comm, probe_at, what):
     """Build and solve one discretisation; returns (BeamModel, StaticResult, value, seconds)."""
     from ..io.probes import evaluate_points
-    from .condensed import build_model
+    from .planar_condensed import build_model
     from .static import solve_static
 
     t0 = time.perf_counter()

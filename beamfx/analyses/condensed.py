@@ -30,7 +30,6 @@ from ..physics.rotations import np_exp_rotation
 from ..spec import resolve_point
 from .discretisation import Discretised, discretise
 from .dofs import constrained_dofs, global_size, owned_size
-from .model import BeamModel
 from .trimming import condensed_fit
 
 #: largest rotation the rotation vector is trusted with (the map ψ -> R is singular at 2π)
@@ -39,19 +38,6 @@ MAX_ANGLE = np.radians(330.0)
 
 class RotationRangeError(ValueError):
     """A rotation beyond :data:`MAX_ANGLE` in the condensed model."""
-
-
-def build_model(model, comm, extra_points=(), condense=False):
-    """The statically condensed model of ``model`` if ``condense`` (the
-    :class:`~beamfx.analyses.planar_condensed.PlanarCondensedModel` of a planar model, else
-    the :class:`CondensedModel`), else its :class:`~beamfx.analyses.model.BeamModel`."""
-    if not condense:
-        return BeamModel(model, comm, extra_points=extra_points)
-    if model.kinematics.plane:
-        from .planar_condensed import PlanarCondensedModel
-
-        return PlanarCondensedModel(model, comm, extra_points=extra_points)
-    return CondensedModel(model, comm, extra_points=extra_points)
 
 
 class FollowerCoupling:
@@ -347,7 +333,7 @@ class CondensedModel(Discretised):
         cache = self._integrator = self._integrator or {}
         if subintervals not in cache:
             gx, gw = np.polynomial.legendre.leggauss(self.degree + 2)
-            local = ((np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals)
+            local = (np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals
             points = (xi[:, None] * local.ravel()[None, :]).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| (t0·t_s) u'
             sign = ufl.dot(self.t_s, self.discretisation.t0)

@@ -65,6 +65,19 @@ def chord_increments(theta0, theta1, chord, h, sign, A, n):
     return bend + strain
 
 
+def build_model(model, comm, extra_points=(), condense=False):
+    """The model a run solves: the statically condensed one of ``model`` if ``condense``
+    (:class:`PlanarCondensedModel` of a planar model, else the spatial
+    :class:`~beamfx.analyses.condensed.CondensedModel`), else its
+    :class:`~beamfx.analyses.model.BeamModel` (full or planar)."""
+    if not condense:
+        from .model import BeamModel
+
+        return BeamModel(model, comm, extra_points=extra_points)
+    cls = PlanarCondensedModel if model.kinematics.plane else CondensedModel
+    return cls(model, comm, extra_points=extra_points)
+
+
 class PlanarCondensedModel(CondensedModel):
     """The statically condensed beam of a planar :class:`~beamfx.spec.Model`
     (``kinematics.plane`` set): ``w`` is the angle θ about the plane's normal on ``W`` (P_k,
@@ -130,9 +143,7 @@ class PlanarCondensedModel(CondensedModel):
         """Whether :meth:`sync` integrates the centre line in closed form: P1 (straight cells,
         θ linear) and every section field constant in a cell."""
         d = self.discretisation
-        constant = all(
-            f.function_space.ufl_element().degree() == 0 for f in (d.stiffness, d.twist)
-        )
+        constant = all(f.function_space.ufl_element().degree() == 0 for f in (d.stiffness, d.twist))
         return self.degree == 1 and constant
 
     def _data(self):
@@ -145,18 +156,20 @@ class PlanarCondensedModel(CondensedModel):
 
         d, m = self.discretisation, self.mesh.mesh
         if self._cell_data is None:
+            cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
             A = d.Lam0 * self.compliance * d.Lam0.T
             a, b, _ = PLANES[self.kin.plane]
-            values = ufl.as_vector([A[a, a], A[a, b], A[b, b]])
-            statics = fem.Expression(values, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
+            AA = np.zeros((len(cells), 3))  # the Kirchhoff rod: no compliance (UFL's zero)
+            if self.kin.shear or self.kin.stretch:
+                values = ufl.as_vector([A[a, a], A[a, b], A[b, b]])
+                statics = fem.Expression(values, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
+                AA = statics.eval(cells).reshape(-1, 3)
             force = None  # no forces: n = 0 (and no expression with no domain to compile)
             if self._forces:
                 n = self.load_factor * self.section_force()
                 force = fem.Expression(n, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
-            cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
             nodes = m.geometry.dofmap.array.reshape(-1, 2)[: len(cells)]
             chord = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]
-            AA = statics.eval(cells).reshape(-1, 3)
             block = np.stack([AA[:, [0, 1]], AA[:, [1, 2]]], axis=1)
             sign = np.where(self._flipped[: len(cells)], -1.0, 1.0)
             self._cell_data = (cells, chord, sign, block, force)
@@ -186,4 +199,4 @@ class PlanarCondensedModel(CondensedModel):
         return inc
 
 
-__all__ = ["PlanarCondensedModel", "chord_increments", "plane_complex"]
+__all__ = ["PlanarCondensedModel", "build_model", "chord_increments", "plane_complex"]

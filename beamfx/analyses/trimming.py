@@ -166,13 +166,16 @@ def choose_plane(model, analysis, settings=None, free_body=False):
     return Trim(None, True, "full model: not a plane problem (" + "; ".join(reasons) + ")")
 
 
-def trimming_summary(trim, kin, unknowns):
+def trimming_summary(trim, kin, unknowns, condensed=False):
     """Log line and results entry of the trimming, with the unknowns the planar model saves
-    (a planar model has 3 unknowns per node; the full one 7 with quaternions, 6 if linear)."""
+    (a planar model has 3 unknowns per node; the full one 7 with quaternions, 6 if linear).
+    ``condensed``: ``unknowns`` are those of the planar condensed model (1 per node), and
+    the line names the planar model's."""
     entry = {"plane": trim.plane, "automatic": trim.automatic, "reason": trim.reason}
     if not kin.plane:
         return trim.reason, entry
-    nodes = unknowns // 3
+    nodes = unknowns // (1 if condensed else 3)
+    unknowns = 3 * nodes
     full = 3 + (4 if kin.finite else 3)
     entry.update(unknowns=unknowns, unknowns_full_model=nodes * full, per_node=(3, full))
     line = (
@@ -229,14 +232,14 @@ def condensing_summary(kin, unknowns):
     nodes = unknowns // per_node
     name = "planar statically condensed" if kin.plane else "statically condensed"
     field = f"the angle about the plane's normal ({kin.plane})" if kin.plane else "the rotations"
-    kept = ", ".join(
-        [w for w, on in (("shear", kin.shear), ("stretch", kin.stretch)) if on]
-    ) or "neither shear nor stretch"
+    kept = (
+        ", ".join([w for w, on in (("shear", kin.shear), ("stretch", kin.stretch)) if on])
+        or "neither shear nor stretch"
+    )
     line = (
         f"{name} (a cantilever under point loads: the section force is known): {field} the "
         f"only unknown, {per_node} per node instead of {full}, {unknowns} instead of "
-        f"{nodes * full}; {kept} kept"
-        + ("; any number of turns" if kin.plane else "")
+        f"{nodes * full}; {kept} kept" + ("; any number of turns" if kin.plane else "")
     )
     entry = {
         "model": "planar_condensed" if kin.plane else "condensed",

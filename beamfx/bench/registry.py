@@ -47,6 +47,9 @@ class Case:
     scale: float | None = None  # error = max |value - ref| / scale (None: relative per value)
     note: str = ""
     extra: dict = field(default_factory=dict)
+    #: the scene builder picks the model as for a scene file (planar, statically condensed:
+    #: :func:`beamfx.scene.load.choose_model`); False: the case's model as built
+    choose_model: bool = False
 
 
 REGISTRY: dict[str, Case] = {}

@@ -20,7 +20,6 @@ def run_setting(case, elements, degree):
     run writes. The solve-only time and its split are the analysis's own figures."""
     import tempfile
 
-    from ..analyses.model import BeamModel
     from ..solvers.forms import compile_seconds
     from .profiling import jit_seconds
     from .scenes import case_scene, run_in_process
@@ -42,6 +41,7 @@ def run_setting(case, elements, degree):
         "elements": elements,
         "degree": degree,
         "unknowns": run.model["unknowns"],
+        "formulation": formulation(run.model),
         "newton_iterations": run.result.newton_iterations,
         "load_steps": len(run.result.load_steps),
         "wall_s_cold": cold,
@@ -49,10 +49,27 @@ def run_setting(case, elements, degree):
         "wall_s_warm": newton_seconds(result.seconds),
         "jit_s": jit,
         "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
-        **jit_seconds(case.id, BeamModel(scene.model, extra_points=case.probes.values())),
+        **jit_seconds(case.id, _model_of(scene, case)),
         "values": {k: float(v) for k, v in case.measure(run.probes).items()},
         "path": [{k: float(v) for k, v in p.items()} for p in path],
     }
+
+
+def formulation(entry):
+    """What solved a run, from its results.json ``model`` entry: "planar condensed",
+    "condensed", "planar" or "full"."""
+    if entry.get("condensed"):
+        return "planar condensed" if entry.get("plane") else "condensed"
+    return "planar" if entry.get("plane") else "full"
+
+
+def _model_of(scene, case):
+    """The model the run of ``scene`` solves (condensed where the scene builder chose it)."""
+    from mpi4py import MPI
+
+    from ..analyses.planar_condensed import build_model
+
+    return build_model(scene.model, MPI.COMM_WORLD, case.probes.values(), scene.condense)
 
 
 def rates(rows):

@@ -13,7 +13,20 @@ def case_scene(case, elements, degree, analysis="static", **settings):
     spec, steps = case.build(elements, degree)
     if "steps" in {f.name for f in fields(lookup(analysis).settings)}:
         settings.setdefault("steps", steps)
-    return analysis_scene(case.id, spec, analysis, case.probes, **settings)
+    scene = analysis_scene(case.id, spec, analysis, case.probes, **settings)
+    return chosen_model(scene) if case.choose_model else scene
+
+
+def chosen_model(scene):
+    """``scene`` with the model the scene builder would pick for it from a file ([model]
+    plane and condense "auto": planar, statically condensed)."""
+    from dataclasses import replace
+
+    from ..analyses.registry import analysis as lookup
+    from ..scene.load import choose_model
+
+    model, trim, condense = choose_model(scene.model, lookup(scene.analysis), scene.settings)
+    return replace(scene, model=model, trimming=trim, condense=condense)
 
 
 def setting_scene(case, setting):

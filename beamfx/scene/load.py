@@ -109,13 +109,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
             f"{file}: supports: none given; the structure is free (rigid-body motion), which "
             "only a modal analysis without pre-stress or a transient from rest can take"
         )
-    model, trimming = _trim(model, plane, analysis, settings)
-    if condense == "auto":
-        from ..analyses.trimming import condensed_fit
-
-        condense = condensed_fit(model, analysis.name) is None
-    else:
-        condense = False
+    model, trimming, condense = choose_model(model, analysis, settings, plane, condense)
     accuracy = _accuracy(accuracy_table, probes, analysis.name, limits)
     _check_model(model, file)
     return Scene(
@@ -244,6 +238,18 @@ def _analysis(t, model, limits):
             f"{limits.max_count} ([limits] max_count raises it)",
         )
     return entry, settings
+
+
+def choose_model(model, analysis, settings, plane="auto", condense="auto"):
+    """The model the scene builder solves ``model`` with, for ``analysis`` (a registry
+    entry) and its ``settings``: (model with the planar kinematics where chosen,
+    :class:`~beamfx.analyses.trimming.Trim`, whether it is statically condensed). ``plane``
+    and ``condense`` are the ``[model]`` keys; with both "auto" a static cantilever under point
+    loads in a plane gets the planar condensed model (the angle the only unknown)."""
+    from ..analyses.trimming import condensed_fit
+
+    model, trimming = _trim(model, plane, analysis, settings)
+    return model, trimming, condense == "auto" and condensed_fit(model, analysis.name) is None
 
 
 def _trim(model, plane, analysis, settings):

@@ -18,7 +18,7 @@ pytestmark = pytest.mark.mpi
 def test_bend45_probes_match_serial(follower, condensed):
     from dataclasses import replace
 
-    from beamfx.analyses.condensed import build_model
+    from beamfx.analyses.planar_condensed import build_model
 
     spec = load_scene(default_scene_path()).model
     kind = "follower" if follower else "dead"

@@ -13,7 +13,16 @@ from beamfx.analyses.formulation import BEAM_FORMULATION_MEMBERS, FORMULATION_ME
 PACKAGE = Path(__file__).resolve().parents[2] / "beamfx"
 
 #: analyses modules that define formulations or read only model descriptions
-NOT_USERS = {"model", "condensed", "discretisation", "formulation", "spec", "checks", "trimming"}
+NOT_USERS = {
+    "model",
+    "condensed",
+    "planar_condensed",
+    "discretisation",
+    "formulation",
+    "spec",
+    "checks",
+    "trimming",
+}
 #: modules that receive a formulation, and the protocol whose members they may use: static
 #: solves, the writers and the runner any Formulation (the condensed model too); the other
 #: analyses a BeamFormulation
