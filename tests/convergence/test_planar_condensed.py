@@ -37,17 +37,18 @@ def _rollup(turns, elements, degree, kinematics=XZ):
 
 
 @pytest.mark.parametrize("turns", [0.25, 0.5, 1, 2, 5])
-@pytest.mark.parametrize("degree", [1, 2])
-def test_rollup_is_exact_with_one_element(turns, degree):
+@pytest.mark.parametrize("elements, degree", [(1, 1), (1, 2), (4, 4)])
+def test_rollup_is_exact_on_coarse_meshes(turns, elements, degree):
     """θ = M s/EI lies in P_k, so Galerkin gives it exactly (the energy ½EIθ'² − Mθ(L) is
     quadratic: one Newton iteration), and the centre line of a θ linear in the cell is
-    integrated in closed form (P1) or by quadrature split to 0.25 rad parts (P2, error of
+    integrated in closed form (P1) or by quadrature split to 0.25 rad parts (P2, P4: error of
     the p + 2 point Gauss rule ~1e-16). What is left is round-off: |θ| ≤ 10π times a few
     ulps in θ and in sin/cos of it, ~1e-14 of L; 1e-12 leaves a margin for round-off only
-    (the full model's error at 16 x P4 is 8e-13, its 4 x P3 one 2e-5)."""
-    spec, exact = _rollup(turns, 1, degree)
+    (the full model's error at 16 x P4 is 8e-13, its 4 x P3 one 2e-5). 4 x P4 caught FFCx's
+    table rounding (1e-8, :data:`~beamfx.analyses.condensed.EXACT_TABLES`)."""
+    spec, exact = _rollup(turns, elements, degree)
     model, result, x = _tip(PlanarCondensedModel, spec, steps=4)
-    assert model.unknowns() == degree + 1  # one angle per node (the clamped one included)
+    assert model.unknowns() == elements * degree + 1  # one angle per node (clamped included)
     assert model.closed_form() == (degree == 1)
     assert np.abs(x - exact).max() / L < 1e-12
     assert result.newton_iterations <= 2 * len(result.steps)
