@@ -48,17 +48,29 @@ PROBLEMS = {
 }
 
 
+#: the element label of a beamfx record, by the formulation that solved it (bench.run)
+ELEMENTS = {
+    "full": "Simo-Reissner, quaternion field",
+    "planar": "Simo-Reissner, planar (angle field)",
+    "condensed": "Simo-Reissner, condensed (rotation vector field)",
+    "planar condensed": "Simo-Reissner, planar condensed (angle field)",
+}
+
 # why the numbers look as they do (facts of the methods, not of one run)
 NOTES = {
     "rollup_half": "Exudyn's two-node BeamGeometricallyExact interpolates on SE(3): a constant-"
     "curvature arc is in its interpolation space, so pure bending is exact (to Newton "
     "tolerance) with any number of elements and Exudyn reaches round-off in milliseconds. "
-    "beamfx's quaternion-field elements approximate the arc polynomially (O(h^p)); **beamfx is "
-    "not ahead here**: the roll-up is the one load case where a helicoidal element needs no "
-    "refinement. PyElastica applies the end moment as a couple on the last element, which "
+    "beamfx's scene builder picks its planar statically condensed model here (a plane "
+    "cantilever under an end moment): the angle θ(s) is the only unknown, the exact θ = M s/EI "
+    "lies in every P_k, and the centre line of a θ linear in a cell is integrated in closed "
+    "form, so one P1 element (2 unknowns) is exact to round-off at any number of turns; the "
+    "P3/P4 rows are the meshes the quaternion model needed (4 x P3: 5.6e-7 at 91 unknowns). "
+    "PyElastica applies the end moment as a couple on the last element, which "
     "stays straight, so its tip lags by about one element length (first order in h).",
     "rollup_full": "As for the half circle: exact for Exudyn's SE(3) element from 4 elements "
-    "(2 elements fail: each would turn by π, where the SE(3) logarithm is singular). "
+    "(2 elements fail: each would turn by π, where the SE(3) logarithm is singular); exact for "
+    "beamfx's planar condensed model from one element (no 2π limit on the angle). "
     "PyElastica's straight last element lands on the exact tip for the full circle by "
     "symmetry (the tip is the root), so its small error there is a coincidence of this load.",
     "sm23": "The section is 4:1 and the moments are fixed in space, so the curvature varies "
@@ -143,6 +155,7 @@ def export(out_dir):
             data[pid]["moment"] = [0.0, -M, 0.0]
         data[pid] |= {
             "beamfx_case": case.id,
+            "beamfx_settings": [list(x) for x in case.settings],
             "title": PROBLEMS[pid][2],
             "reference": None if case.reference is None else dict(case.reference),
             "error_scale": case.scale,
@@ -172,7 +185,7 @@ def run_beamfx(out_dir, log=print):
                 {
                     "problem": pid,
                     "code": "beamfx",
-                    "element": "Simo-Reissner, quaternion field",
+                    "element": ELEMENTS[row.get("formulation", "full")],
                     "setting": setting,
                     "unknowns": row["unknowns"],
                     "wall_s": row["wall_s_warm"],
