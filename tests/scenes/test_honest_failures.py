@@ -31,6 +31,12 @@ fix = "all"
 at = "b:end"
 force = [0, 0, {force}]
 
+# the planar model (2 displacements and an angle per node), whose Newton path these tests
+# are about; the planar condensed model the builder would pick solves these loads (the
+# stretch and shear F/EA, F/GA follow from the known section force, no Newton on them)
+[model]
+condense = "none"
+
 [analysis]
 type = "static"
 steps = 10
