@@ -34,9 +34,10 @@ from ..solvers.step_control import EasyGrowth, ErrorBased, StepControl, StepTooS
 from .checks import model_size
 from .conserving import Projection
 from .dofs import constrained_dofs, owned_size, subspace_dofs
+from .extrapolation import Extrapolation
 from .section_fields import section_kinetic_energy
 
-SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
+SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
 
 
 @dataclass(frozen=True)
@@ -46,7 +47,7 @@ class TransientSettings:
     t_end: float
     dt: float
     scheme: str = "generalized_alpha"
-    rho_inf: float = 0.9  # generalized-α
+    rho_inf: float = 0.9  # generalized-α (and the base of "extrapolated")
     hht_alpha: float = 0.05  # HHT
     dt_min: float | None = None  # smallest step after cut-backs (default dt/1000)
     easy_iterations: int = 4  # a step in at most this many iterations may grow the next one
@@ -57,6 +58,10 @@ class TransientSettings:
     output_every: int = 1  # ParaView frames every n steps (probes and energies every step)
     checkpoint_every: int = 50  # steps between checkpoints (0: never)
 
+    def __post_init__(self):
+        if self.scheme == "extrapolated" and self.tolerance is not None:
+            raise ValueError('scheme "extrapolated" steps on a fixed grid: no tolerance')
+
     def parameters(self):
         """The :class:`~beamfx.solvers.integrators.AlphaParameters` of ``scheme``."""
         if self.scheme == "hht":
@@ -65,6 +70,9 @@ class TransientSettings:
             return newmark()
         if self.scheme == "conserving":  # trapezoidal steps, then projected (conserving.py)
             return generalized_alpha(1.0)._replace(name="conserving (trapezoidal + projection)")
+        if self.scheme == "extrapolated":  # runs at h and h/2 combined (extrapolation.py)
+            base = generalized_alpha(self.rho_inf)
+            return base._replace(name=f"extrapolated (Richardson h, h/2) {base.name}")
         return generalized_alpha(self.rho_inf)
 
 
@@ -111,6 +119,7 @@ class Dynamics:
         V_u, u_dofs = W.sub(0).collapse()
         self.u_dofs = np.asarray(u_dofs).reshape(-1, kin.displacement_size)
         self.u_points = V_u.tabulate_dof_coordinates()
+        self.extrapolation = None  # the scheme "extrapolated"'s copies (set by its march)
         self.r_dofs = subspace_dofs(W, 1).reshape(-1, kin.rotation_size)
         self._is_displacement = np.zeros(len(self.q_n.x.array), bool)
         self._is_displacement[self.u_dofs.ravel()] = True
@@ -318,7 +327,7 @@ class EnergyBalance:
     def reactions(self):
         """Support reactions at the converged q_{n+1}: call before the state moves on (the
         residual's rates are expressions of the state at t_n)."""
-        self._reaction = self._vector(self.residual) * self.mask if self.moving else 0.0
+        self.reaction = self._vector(self.residual) * self.mask if self.moving else 0.0
 
     def record(self, q_old, h):
         """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0)."""
@@ -326,7 +335,7 @@ class EnergyBalance:
         q = self.dyn.model.w.x.array[owned].copy()
         now = {
             "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
-            "reaction": self._reaction,
+            "reaction": self.reaction,
             "power": self.scalar(self.P) if self.P is not None else 0.0,
         }
         if self.previous is not None:
@@ -391,6 +400,8 @@ def checkpoint_state(dyn, balance, control, t, step):
     """(header, arrays) of the state to go on from ``t``: the state at t_n, the energy
     balance, the step controller (see :mod:`beamfx.io.checkpoint` for the file)."""
     arrays = dyn.state()
+    if dyn.extrapolation:
+        arrays |= dyn.extrapolation.arrays()
     previous = balance.previous or {}
     saved = {"values": dict(balance.values), "initial": balance.initial}
     saved["power"] = previous.get("power")
@@ -408,6 +419,8 @@ def restore_state(saved, dyn, balance, control):
     returns (t, step)."""
     header, arrays = saved
     dyn.set_state({k: arrays[k] for k in ("q_n", "v_n", "a_n", "qdd_n")})
+    if dyn.extrapolation:
+        dyn.extrapolation.restore(arrays)
     b = header["balance"]
     previous = None
     if b["power"] is not None:
@@ -464,10 +477,7 @@ def _step(m, control, t, failed):
     h = control.size = min(wanted, s.t_end - t)
     cutbacks, tried, error = 0, [], None
     while True:
-        dyn.h.value = h
-        model.set_time(t + h)
-        dyn.predict(h)
-        report = m.solver.solve()
+        report = _newton(m, t, h)
         if report.converged and s.tolerance:
             error = dyn.error_estimate(h, s.tolerance, m.length)
             if error <= 1.0 or h <= m.dt_min * (1 + 1e-9):
@@ -490,12 +500,26 @@ def _step(m, control, t, failed):
         m.log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
 
 
+def _newton(m, t, h):
+    """The Newton solve(s) of the step from ``t`` to t + h: ``model.w`` then holds q_{n+1}."""
+    dyn = m.dyn
+    if dyn.extrapolation:
+        return dyn.extrapolation.solve(t, h)
+    dyn.h.value = h
+    m.model.set_time(t + h)
+    dyn.predict(h)
+    return m.solver.solve()
+
+
 def _accept(m, t, h, q_old):
     """Move the state on from ``t`` to t + h after a converged step (``q_old`` gets q_n);
     returns the energy balance at t + h."""
     q_old[:] = m.dyn.q_n.x.array
-    m.balance.reactions()
-    m.dyn.accept(h)
+    if m.dyn.extrapolation:
+        m.dyn.extrapolation.accept()
+    else:
+        m.balance.reactions()
+        m.dyn.accept(h)
     if m.projection:
         m.projection.apply(t, t + h)
     return m.balance.record(q_old, h)
@@ -511,6 +535,8 @@ def _march(model, s, options, prefix, log):
     solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
     balance = EnergyBalance(dyn, solver.F)
     projection = Projection(dyn, balance) if s.scheme == "conserving" else None
+    if s.scheme == "extrapolated":
+        dyn.extrapolation = Extrapolation(dyn, solver, balance)
     dt_min = s.dt_min or s.dt / 1000
     length = model_size(model.spec)
     m = _March(model, s, dyn, solver, balance, projection, dt_min, length, log or (lambda _: None))

@@ -23,7 +23,7 @@ if TYPE_CHECKING:  # heavy (UFL, PETSc): imported where used
     from ..spec import Model
     from .transient import TransientSettings
 
-SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving")
+SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
 ENERGY_KEYS = (
     "kinetic",
     "strain",
@@ -49,7 +49,9 @@ class Settings:
     t_end: float = option(positive=True, doc="end time (s)")
     dt: float = option(positive=True, doc="time step (s); cut back on failure, grown back")
     scheme: str = option("generalized_alpha", choices=SCHEMES, doc="time integrator")
-    rho_inf: float = option(0.9, low=0.0, high=1.0, doc="generalized-α spectral radius")
+    rho_inf: float = option(
+        0.9, low=0.0, high=1.0, doc='generalized-α spectral radius (also of "extrapolated")'
+    )
     hht_alpha: float = option(0.05, low=0.0, high=1 / 3, doc="HHT α")
     dt_min: float | None = option(None, positive=True, doc="smallest step (default dt/1000)")
     tolerance: float | None = option(
@@ -63,6 +65,17 @@ class Settings:
     checkpoint_every: int = option(50, low=0, doc="steps between checkpoints (0: never)")
     start: str = option("rest", choices=("rest", "static"), doc="from rest or a static state")
     steps: int = option(10, positive=True, doc="load steps of a static start")
+
+    def problems(self):
+        """(key, message) of settings that do not go together (the scene reader raises)."""
+        if self.scheme == "extrapolated" and self.tolerance is not None:
+            yield (
+                "tolerance",
+                (
+                    'scheme = "extrapolated" steps on a fixed grid (its runs at dt and dt/2 must '
+                    "share their steps): remove tolerance, or choose another scheme"
+                ),
+            )
 
     def free_body(self, spec: "Model") -> bool:
         """A free structure may fly from rest (the mass makes the step's operator regular);

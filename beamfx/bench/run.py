@@ -77,7 +77,12 @@ def rates(rows):
     out = []
     for a, b in pairwise(rows):
         if "dt" in a and "dt" in b and a["elements"] == b["elements"]:  # order in time
-            if abs(b["dt"] - a["dt"] / 2) < 1e-12 * a["dt"] and a["error"] > 0 < b["error"]:
+            same = a.get("scheme") == b.get("scheme")
+            if (
+                same
+                and abs(b["dt"] - a["dt"] / 2) < 1e-12 * a["dt"]
+                and a["error"] > 0 < b["error"]
+            ):
                 rate = float(np.log2(a["error"] / b["error"]))
                 out.append({"degree": a["degree"], "dt": b["dt"], "rate": rate})
             continue
@@ -145,6 +150,7 @@ def run_case(case, log=print):
 
         setting = (cheapest["elements"], cheapest["degree"])
         setting += (cheapest["dt"],) if "dt" in cheapest else ()
+        setting += (cheapest["scheme"],) if "scheme" in cheapest else ()
         with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
             cheapest["wall_s_process"] = process_seconds(case.id, setting, folder)
     out = {

@@ -14,6 +14,9 @@ interpolation between time levels, and massless (algebraic) unknowns are solved 
 Newton's unknown is :math:`q_{n+1}`; the other quantities are affine in it, so the residual
 is a transformation of the equations of motion and its Jacobian follows by differentiation.
 
+:func:`richardson` combines results at h and h/2 to cancel the h² error term (the scheme
+``"extrapolated"``, :mod:`beamfx.analyses.extrapolation`).
+
 Knows nothing of beams: arrays are NumPy arrays, expressions UFL.
 """
 
@@ -92,3 +95,10 @@ class AlphaStep:
     def predict(self, q_n, v_n, a_n, h):
         """Starting guess for q_{n+1}: the step with a_{n+1} = a_n."""
         return q_n + h * v_n + h**2 * 0.5 * a_n
+
+
+def richardson(coarse, fine, order=2):
+    r"""Richardson's combination of a result at step h (``coarse``) and at h/2 (``fine``):
+    :math:`u_{h/2} + (u_{h/2} - u_h)/(2^p - 1)`, which cancels an error term
+    :math:`C h^p` (p = ``order``; p = 2: 4/3 u_{h/2} − 1/3 u_h). Arrays or numbers."""
+    return fine + (fine - coarse) / (2**order - 1)
