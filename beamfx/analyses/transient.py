@@ -124,6 +124,7 @@ class Dynamics:
         self._is_displacement = np.zeros(len(self.q_n.x.array), bool)
         self._is_displacement[self.u_dofs.ravel()] = True
         self._quaternion = kin.finite and not kin.plane
+        self.project_rates = self._quaternion  # see _tangent_rates (and extrapolation.py)
         mesh = model.mesh.mesh
 
         def constant(x):
@@ -226,7 +227,7 @@ class Dynamics:
         v, a, qdd = self.scheme.advance(self.model.w.x.array, *arrays, h)
         self.v_n.x.array[:], self.a_n.x.array[:], self.qdd_n.x.array[:] = v, a, qdd
         self.q_n.x.array[:] = self.model.w.x.array
-        if self._quaternion:
+        if self.project_rates:
             self._tangent_rates()
 
     def _tangent_rates(self):
