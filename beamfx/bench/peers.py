@@ -25,6 +25,7 @@ TARGET = 1e-6  # issue 7: the error at which beamfx must be ahead
 
 # problem id -> (beamfx case id, settings (None: the case's own), what the problem is)
 SPIN_DT = tuple(0.025 / 2**k for k in range(6))
+X = "extrapolated"  # beamfx's scheme of runs at dt and dt/2 combined (analyses/extrapolation.py)
 PROBLEMS = {
     "rollup_half": ("rollup_0.5", None, "roll-up to a half circle, tip moment π EI/L"),
     "rollup_full": ("rollup_1", None, "roll-up to a full circle, tip moment 2π EI/L"),
@@ -37,7 +38,9 @@ PROBLEMS = {
     ),
     "spin_up": (
         "spin_up_time",
-        tuple((4, 2, dt) for dt in SPIN_DT[:-1]) + ((8, 3, SPIN_DT[-2]), (8, 3, SPIN_DT[-1])),
+        tuple((4, 2, dt) for dt in SPIN_DT[:-1])
+        + ((2, 2, SPIN_DT[0], X), (4, 2, SPIN_DT[0], X), (8, 2, SPIN_DT[0], X))
+        + ((8, 3, SPIN_DT[2], X),),
         "spin-up manoeuvre (VM258), extremes over 0–18 s in the hub frame",
     ),
     "bend45": (
@@ -84,19 +87,27 @@ NOTES = {
     "inertia; values are frequencies divided by the Euler-Bernoulli theory, the reference is "
     "the finest beamfx setting (16 x P4). Exudyn's eigenvalues are dense "
     "(ComputeODE2Eigenvalues), beamfx's shift-invert SLEPc, one solve per frequency.",
-    "spin_up": "Reference values are withheld (VM258): the reference is the finest beamfx "
-    "setting (8 x P3, dt = 0.025/32). Both codes use generalized-α with ρ∞ = 0.9, second "
-    "order in time, so dt sets the error; at equal dt beamfx's planar model has fewer "
-    "unknowns (4 quadratic elements, 27) than Exudyn's 32 two-node elements (99). The Exudyn "
-    "hub angle is a Python offset user function, called at every Newton iteration. Exudyn's "
-    "Newton absolute tolerance had to be raised to 1e-6 N: at its default, Newton stalls at "
-    "round-off (EA = 2.8e7) and the adaptive step collapses (95 s instead of 0.6 s). At the "
-    "target (Exudyn's best error, 32 elements at dt = 0.00125) the two wall times are within "
-    "a few per cent, inside the run-to-run noise of a shared 2-core machine: **beamfx is not "
-    "clearly ahead here**; it needs dt = 0.00625 (4 x P2) for that error, where Exudyn needs "
-    "dt = 0.00125, and beamfx's cost per step (about 0.4 ms, 27 unknowns) is several times "
-    "Exudyn's (0.2 ms per step at 99 unknowns): the assembly through DOLFINx/PETSc per step "
-    "dominates at this size.",
+    "spin_up": "Reference values are withheld (VM258): the reference is the last beamfx "
+    'setting (8 x P3, scheme "extrapolated" at dt = 0.00625: generalized-α with ρ∞ = 0.8 at '
+    "dt and dt/2, Richardson-combined; its error in time is about 1e-8, in space that of "
+    "8 x P3). The plain beamfx rows and Exudyn use generalized-α with ρ∞ = 0.9, second "
+    "order in time, so dt sets the error; the extrapolated rows (three Newton solves per "
+    "step: 2.2 to 2.8 times the iterations of the plain run at the same dt) are third to fourth "
+    "order in time, and at dt = 0.025 their error in time (2e-6) is below the error in space "
+    "of 4 x P2 (1e-4), so the mesh sets it: 8 x P2 costs little more per iteration. At "
+    "equal dt beamfx's planar model has fewer unknowns (4 quadratic elements, 27) than "
+    "Exudyn's 32 two-node elements (99). The Exudyn hub angle is a Python offset user "
+    "function, called at every Newton iteration. Exudyn's Newton absolute tolerance had to "
+    "be raised to 1e-6 N: at its default, Newton stalls at round-off (EA = 2.8e7) and the "
+    "adaptive step collapses (95 s instead of 0.6 s). With the plain scheme beamfx needs "
+    "dt = 0.00625 (4 x P2, 4882 Newton iterations) for Exudyn's best error (32 elements at "
+    "dt = 0.00125), at a wall time within a few per cent of Exudyn's: its cost per step "
+    "(about 0.4 ms, 27 unknowns) is several times Exudyn's (0.2 ms per step at 99 unknowns), "
+    "the assembly through DOLFINx/PETSc per step dominating at this size. The extrapolated "
+    "rows at dt = 0.025 take about 5100 iterations, and their error is that of the mesh "
+    "(4 x P2: 1e-4, 8 x P2: 7e-6). Near 1e-3 extrapolation does not pay: its coarsest "
+    "usable dt is 0.025 (at 0.05 the base with ρ∞ = 0.8 needs cut-backs; with ρ∞ = 0.5 "
+    "the mean stretch is off by 1.3 %), which costs more than the plain run at dt = 0.0125.",
     "bend45": "Reference withheld: the finest beamfx setting (32 x P4). Exudyn's two-node "
     "elements on the arc (nodes on the circle, chord lengths) converge at second order.",
 }
@@ -181,11 +192,15 @@ def run_beamfx(out_dir, log=print):
             setting = f"{row['elements']} x P{row['degree']}"
             if "dt" in row:
                 setting += f", dt {row['dt']:g}"
+            element = ELEMENTS[row.get("formulation", "full")]
+            if "scheme" in row:  # a line of its own in the plot
+                setting += f", {row['scheme']}"
+                element += f"; {row['scheme']} in time"
             records.append(
                 {
                     "problem": pid,
                     "code": "beamfx",
-                    "element": ELEMENTS[row.get("formulation", "full")],
+                    "element": element,
                     "setting": setting,
                     "unknowns": row["unknowns"],
                     "wall_s": row["wall_s_warm"],
