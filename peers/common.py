@@ -105,6 +105,35 @@ def hub_angle(t):
     return np.where(t < 15, ramp, 6 * t - 45)
 
 
+def least(t, y):
+    """As beamfx.bench.transient.least: the minimum between the samples (a quartic through
+    the five samples around the least one)."""
+    i = int(np.argmin(y))
+    lo = min(max(i - 2, 0), max(len(y) - 5, 0))
+    ts, ys = t[lo : lo + 5], y[lo : lo + 5]
+    if len(ts) < 5 or i in (0, len(y) - 1):
+        return float(y[i])
+    scale = ts[-1] - ts[0]
+    poly = np.polynomial.Polynomial.fit((ts - t[i]) / scale, ys, 4, domain=[-1, 1], window=[-1, 1])
+    a, b = (t[i - 1] - t[i]) / scale, (t[i + 1] - t[i]) / scale
+    roots = poly.deriv().roots()
+    candidates = [r.real for r in roots if abs(r.imag) < 1e-12 and a <= r.real <= b]
+    return float(min([y[i], *(poly(r) for r in candidates)]))
+
+
+def time_mean(t, y, start, end):
+    """As beamfx.bench.transient.time_mean: Simpson on a uniform even grid, else trapezoidal."""
+    m = (t >= start - 1e-9) & (t <= end + 1e-9)
+    ts, ys = t[m], y[m]
+    span = ts[-1] - ts[0]
+    if np.ptp(np.diff(ts)) < 1e-6 * (ts[1] - ts[0]) and len(ts) % 2 == 1:
+        h = span / (len(ts) - 1)
+        area = h / 3 * (ys[0] + ys[-1] + 4 * ys[1:-1:2].sum() + 2 * ys[2:-1:2].sum())
+    else:
+        area = np.trapz(ys, ts)
+    return float(area / span)
+
+
 def spin_up_values(t, x, y, theta, L):
     """beamfx's spin-up measure from the tip history: positions (x, y) and the planar angle."""
     t, x, y, theta = (np.asarray(a, float) for a in (t, x, y, theta))
@@ -113,12 +142,11 @@ def spin_up_values(t, x, y, theta, L):
     axial = c * x + s * y - L
     transverse = -s * x + c * y
     rel = theta - psi
-    late = t > 15.0
     return {
-        "axial_min": float(axial.min()),
-        "transverse_min": float(transverse.min()),
-        "relative_rotation_min": float(rel.min()),
-        "stretch_mean_15_18": float(axial[late].mean()),
+        "axial_min": least(t, axial),
+        "transverse_min": least(t, transverse),
+        "relative_rotation_min": least(t, rel),
+        "stretch_mean_15_18": time_mean(t, axial, 15.0, 18.0),
     }
 
 

@@ -204,13 +204,15 @@ def least(t, y):
 def time_mean(t, y, start, end):
     """Mean of the sampled ``y`` over [``start``, ``end``] (samples at both ends): Simpson's
     rule on a uniform even grid, else the trapezoidal rule."""
-    from scipy.integrate import simpson
-
     m = (t >= start - 1e-9) & (t <= end + 1e-9)
     ts, ys = t[m], y[m]
-    uniform = np.ptp(np.diff(ts)) < 1e-6 * (ts[1] - ts[0])
-    area = simpson(ys, x=ts) if uniform and len(ts) % 2 == 1 else np.trapz(ys, ts)
-    return float(area / (ts[-1] - ts[0]))
+    span = ts[-1] - ts[0]
+    if np.ptp(np.diff(ts)) < 1e-6 * (ts[1] - ts[0]) and len(ts) % 2 == 1:
+        h = span / (len(ts) - 1)
+        area = h / 3 * (ys[0] + ys[-1] + 4 * ys[1:-1:2].sum() + 2 * ys[2:-1:2].sum())
+    else:
+        area = np.trapz(ys, ts)
+    return float(area / span)
 
 
 def spin_up_measure(history, spec=None):
@@ -249,19 +251,22 @@ NOTE = (
     "Values: extremes over 0–18 s of the tip displacement in the hub frame (axial, "
     "transverse) and of the tip rotation relative to the hub, and the mean axial stretch over "
     f"15–18 s, which must equal ρA Ω² L³/(3 EA) = {HAND_STRETCH:.6e} (Ω = 6 rad/s). The "
-    "reference values are withheld: the finest setting is the reference. The inertial-frame "
-    "coordinates turn through 63 rad; the dissipative integrator also damps that rigid "
-    "motion slightly at large Ω·dt, which is why dt, not the mesh, sets the accuracy."
+    "reference values are withheld: the finest setting is the reference. The extremes are "
+    "read between the samples (a quartic through the five samples around the least one) and "
+    "the mean by Simpson's rule, so that the sampling adds no O(dt²) error of its own. The "
+    "inertial-frame coordinates turn through 63 rad, and dt, not the mesh, sets the "
+    "accuracy: the second-order error of the integration (the trapezoidal rule's peaks "
+    "differ from generalized-α's by about 1e-6 at dt = 0.00625, the numerical damping is "
+    "not what limits)."
 )
 
 
 NOTE_EXTRAPOLATED = (
-    'Spin-up manoeuvre as above with scheme = "extrapolated": generalized-α with '
-    f"ρ∞ = {EXTRAPOLATED_RHO} run at dt and dt/2 in lockstep, the shown state "
-    "q_{dt/2} + (q_{dt/2} − q_dt)/3 (Richardson), three Newton solves per step of dt. The "
-    "reference is the finest setting of the same mesh, so the errors are those of time "
-    "alone. The extremes are read between the samples (a quartic through five samples) and "
-    "the mean stretch by Simpson's rule, so that the sampling does not add an O(dt²) error."
+    'The spin-up of spin_up_time (same values, same reading) with scheme = "extrapolated": '
+    f"generalized-α with ρ∞ = {EXTRAPOLATED_RHO} run at dt and dt/2 in lockstep, the shown "
+    "state q_{dt/2} + (q_{dt/2} − q_dt)/3 (Richardson), three Newton solves per step of dt "
+    "(docs/validation/time_extrapolation.md). The reference is the finest setting of the "
+    "same mesh, so the errors are those of time alone."
 )
 
 
