@@ -23,6 +23,10 @@ T/160 equally), without it the order is 4. It is there for ρ∞ = 1, whose mean
 along the quaternion's norm would grow; with ρ∞ < 1 they are damped, so the copies skip it
 (ρ∞ = 1 in 3D keeps it, and with it the stall).
 
+The energy balance (:class:`~beamfx.analyses.transient.EnergyBalance`) sums the works
+over the shown steps by the trapezoidal rule, second order; its remainder ("numerical") is
+then mostly that quadrature error, of either sign.
+
 Cost: three Newton solves per macro step (one at H, two at H/2), i.e. the two runs at H and
 H/2 that a user would make to check convergence, with the better answer as a by-product.
 It needs smooth data: the h² expansion holds for loads and support motions that are smooth

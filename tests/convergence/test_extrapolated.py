@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scenekit import CLAMP, cantilever, spun_beam
+from scenekit import CLAMP, SPIN_HISTORY, cantilever, spun_beam
 
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.transient import TransientSettings, solve_transient
@@ -135,3 +135,29 @@ def test_scene_keys_are_checked():
     good = tomllib.loads(text.replace("KEYS", 'scheme = "extrapolated"\nrho_inf = 0.8'))
     settings = parse_scene(good, "spin.toml").settings.solver()
     assert settings.scheme == "extrapolated" and settings.parameters().name.startswith("extra")
+
+
+def test_scene_run_writes_the_combined_history(tmp_path):
+    """``beamfx run`` of a scene with the scheme: results.json names it, probes.csv has a row
+    per step of dt (the substeps are not rows). The energy balance's works are trapezoidal
+    sums over the shown steps, second order: what it leaves ("numerical") is their
+    quadrature error, measured -8.8 J of 10025 J at dt = 0.025, and falls by 4 when dt
+    halves (3.5 to 4.5: the trapezoidal rule's h² term with a relative h² correction)."""
+    import json
+
+    from beamfx.cli import main
+
+    numerical = []
+    for dt in (0.025, 0.0125):
+        text = spun_beam(SPIN_HISTORY, 0.5, dt=dt, plane="xy")
+        text = text.replace(f"dt = {dt!r}", f'dt = {dt!r}\nscheme = "extrapolated"\nrho_inf = 0.8')
+        (tmp_path / "spin.toml").write_text(text)
+        out = tmp_path / f"out{dt}"
+        assert main(["run", str(tmp_path / "spin.toml"), "--out", str(out)]) in (0, None)
+        results = json.loads((out / "results.json").read_text())
+        assert results["scheme"].startswith("extrapolated (Richardson h, h/2) generalized-α")
+        rows = np.genfromtxt(out / "probes.csv", delimiter=",", names=True)
+        assert len(rows) == round(0.5 / dt) + 1 and np.allclose(np.diff(rows["time"]), dt)
+        assert rows[-1]["work_supports"] > 5000.0
+        numerical.append(rows[-1]["numerical"])
+    assert 3.5 < numerical[0] / numerical[1] < 4.5, numerical
