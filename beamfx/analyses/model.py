@@ -16,6 +16,8 @@ from ..physics.rotations import np_quaternion
 from ..spec import DOF_NAMES
 from .checks import check_planar
 from .discretisation import Discretised, discretise
+from .mechanisms import check_mechanisms
+from .releases import HINGE_SIZE, hinge_bcs, hinge_fields, member_rotation
 from .dofs import global_size, subspace_dofs
 
 
@@ -59,7 +61,10 @@ class BeamModel(Discretised):
         cell = m.ufl_cell()
         U = ufl.VectorElement("Lagrange", cell, p, dim=self.kin.displacement_size)
         Q = ufl.VectorElement("Lagrange", cell, p, dim=self.kin.rotation_size)
-        self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q]))
+        # released joints: the hinge unknowns of the enriched elements (analyses.releases)
+        self.hinges = hinge_fields(d, self.kin, model.releases) if model.releases else None
+        H = [ufl.VectorElement("DG", cell, 0, dim=HINGE_SIZE)] if model.releases else []
+        self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q, *H]))
         self.w = fem.Function(self.W, name="unknowns")
         quaternion = self.kin.finite and not self.kin.plane
         self._q0_dofs = subspace_dofs(self.W, 1, 0) if quaternion else []
@@ -69,16 +74,19 @@ class BeamModel(Discretised):
         self.time, self._load_histories = 0.0, []
         self._build_forms()
         self.bcs, self._bc_values = self._build_supports()
+        if model.releases:
+            self.bcs += hinge_bcs(self.W, self.hinges)
+            check_mechanisms(self)
 
     # --- forms -----------------------------------------------------------------------------
 
     def _build_forms(self):
         spec, kin, d = self.spec, self.kin, self.discretisation
-        u, rot = ufl.split(self.w)
+        u, rot = ufl.split(self.w)[:2]
         u3 = displacement(kin, u)
         test = ufl.TestFunction(self.W)
-        v_u, v_rot = ufl.split(test)
-        Gamma, K = strains(kin, u, rot, d.t0, d.Lam0)
+        v_u, v_rot = ufl.split(test)[:2]
+        Gamma, K = strains(kin, u, self._member_rotation(), d.t0, d.Lam0)
         Pi = d.strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, d.dx)
@@ -126,6 +134,14 @@ class BeamModel(Discretised):
             self.work = work
             self.F -= self.load_factor * work
         self.J = ufl.derivative(self.F, self.w, ufl.TrialFunction(self.W))
+
+    def _member_rotation(self):
+        """The rotation field of the members: the node field, with the released relative
+        rotations in the elements next to released ends (:mod:`beamfx.analyses.releases`)."""
+        parts = ufl.split(self.w)
+        if self.hinges is None:
+            return parts[1]
+        return member_rotation(self.kin, parts[1], parts[2], self.hinges)
 
     def _history_factor(self, load):
         """1, or a constant that :meth:`set_time` sets to the load's history f(t)."""
@@ -261,8 +277,8 @@ class BeamModel(Discretised):
         """(X, u, rotation output, Λ0, N = C_N Γ, M = C_M K) as UFL, for
         :func:`beamfx.io._sections.section_expression`."""
         d = self.discretisation
-        u, rot = ufl.split(self.w)
-        Gamma, K = strains(self.kin, u, rot, d.t0, d.Lam0)
+        u, rot = ufl.split(self.w)[:2]
+        Gamma, K = strains(self.kin, u, self._member_rotation(), d.t0, d.Lam0)
         X = ufl.SpatialCoordinate(d.mesh.mesh)
         return (
             X,

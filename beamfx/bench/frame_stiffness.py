@@ -4,7 +4,8 @@ Timoshenko member stiffness (Przemieniecki 1968, §5.6), in NumPy.
 A reference for beamfx's linear kinematics on frames of straight prismatic members loaded at
 the joints: there the exact Timoshenko solution is cubic in the displacement and quadratic in
 the rotation along each member, which P3 elements hold exactly, so beamfx must agree to
-round-off. Member axes are beamfx's (:func:`~beamfx.geometry.frames.frame_from_tangent`: x the
+round-off. A released member end (``Model.releases``) has its own rotation, the node's plus
+the released components along the joint axes (unknowns of their own). Member axes are beamfx's (:func:`~beamfx.geometry.frames.frame_from_tangent`: x the
 tangent, z the orientation vector made normal to it, y = z × x), stiffnesses (EA, GA_y, GA_z,
 GJ, EI_y, EI_z) those of the member's section: EI_z and GA_y act in the x–y plane,
 Φ_y = 12 EI_z / (GA_y L²), and EI_y, GA_z in the x–z plane.
@@ -27,6 +28,7 @@ class FrameProblem(NamedTuple):
     axes: np.ndarray  # (m, 3, 3) Λ0 of each member (columns x, y, z in global axes)
     fixed: dict  # {node: [dof index 0..5]}
     loads: dict  # {node: (6,) force and moment, global axes}
+    releases: dict = {}  # {(member, end 0|1): (3, k) released joint axes as columns}
 
 
 def _bending(L, EI, GA, sign):
@@ -61,25 +63,34 @@ def solve(problem):
     """Nodal displacements and rotations (n, 6) and the reactions {node: (6,)} (force and
     moment, global axes: K u − f at the fixed dofs)."""
     n = len(problem.nodes)
-    K = np.zeros((6 * n, 6 * n))
-    for (a, b), C, lam in zip(problem.members, problem.stiffness, problem.axes):
+    hinge = {key: E.shape[1] for key, E in problem.releases.items()}
+    size = 6 * n + sum(hinge.values())
+    K = np.zeros((size, size))
+    first = 6 * n  # a released member end: its rotation = the node's + E φ (φ: own unknowns)
+    for m, ((a, b), C, lam) in enumerate(zip(problem.members, problem.stiffness, problem.axes)):
         L = np.linalg.norm(problem.nodes[b] - problem.nodes[a])
         T = np.kron(np.eye(4), lam.T)
-        dofs = np.r_[6 * a : 6 * a + 6, 6 * b : 6 * b + 6]
-        K[np.ix_(dofs, dofs)] += T.T @ member_stiffness(L, C) @ T
-    f = np.zeros(6 * n)
+        G = np.zeros((12, size))  # member end dofs (global axes) from the unknowns
+        G[:6, 6 * a : 6 * a + 6] = G[6:, 6 * b : 6 * b + 6] = np.eye(6)
+        for end in (0, 1):
+            E = problem.releases.get((m, end))
+            if E is not None:
+                G[6 * end + 3 : 6 * end + 6, first : first + E.shape[1]] = E
+                first += E.shape[1]
+        K += G.T @ T.T @ member_stiffness(L, C) @ T @ G
+    f = np.zeros(size)
     for node, load in problem.loads.items():
         f[6 * node : 6 * node + 6] += load
     fixed = np.array([6 * node + d for node, ds in problem.fixed.items() for d in ds], int)
-    free = np.setdiff1d(np.arange(6 * n), fixed)
-    u = np.zeros(6 * n)
+    free = np.setdiff1d(np.arange(size), fixed)
+    u = np.zeros(size)
     u[free] = np.linalg.solve(K[np.ix_(free, free)], f[free])
     r = K @ u - f
     reactions = {
         node: np.where(np.isin(np.arange(6), ds), r[6 * node : 6 * node + 6], 0.0)
         for node, ds in problem.fixed.items()
     }
-    return u.reshape(n, 6), reactions
+    return u[: 6 * n].reshape(n, 6), reactions
 
 
 def problem_from_model(spec, tol=1e-9):
@@ -109,8 +120,20 @@ def problem_from_model(spec, tol=1e-9):
     for p in spec.point_loads:
         i = node(resolve_point(spec, p.at)[2])
         loads[i] = loads.get(i, np.zeros(6)) + np.r_[p.force, p.moment]
+    releases = {}
+    names = [b.name for b in spec.beams]
+    for rel in spec.releases:
+        beam, _, where = rel.at.partition(":")
+        cols = [np.asarray(rel.axes, float)[("rx", "ry", "rz").index(c)] for c in rel.released]
+        releases[(names.index(beam), int(where == "end"))] = np.array(cols).T
     return FrameProblem(
-        np.array(nodes), np.array(members), np.array(stiffness), np.array(axes), fixed, loads
+        np.array(nodes),
+        np.array(members),
+        np.array(stiffness),
+        np.array(axes),
+        fixed,
+        loads,
+        releases,
     )
 
 

@@ -116,6 +116,19 @@ class PointMass:
 
 
 @dataclass(frozen=True)
+class Release:
+    """A member end joined to its node with some rotations free (a hinge, a pin): ``at`` is
+    ``beam:start`` or ``beam:end``; ``released`` a subset of ("rx", "ry", "rz"), components
+    in the joint axes ``axes`` (rows x, y, z: an orthonormal basis, global coordinates in the
+    reference state; they turn with the joint). ``joint`` names it in messages."""
+
+    at: str
+    released: tuple = ("rx", "ry", "rz")
+    axes: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    joint: str = ""
+
+
+@dataclass(frozen=True)
 class Model:
     """The whole structure: beams, supports, loads, springs, masses and kinematics options."""
 
@@ -127,6 +140,7 @@ class Model:
     gravity: tuple = (0.0, 0.0, 0.0)
     kinematics: Kinematics = field(default_factory=Kinematics)
     point_masses: tuple = ()
+    releases: tuple = ()  #: :class:`Release` of member ends (joints that are not rigid)
 
     def beam(self, name):
         """The beam named ``name`` (KeyError if none)."""
