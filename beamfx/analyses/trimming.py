@@ -203,6 +203,8 @@ def condensed_fit(model, analysis="static"):
         return "the kinematics are linear (one linear solve already)"
     if len(model.beams) != 1:
         return "it models one beam"
+    if model.releases:
+        return "released joints are not implemented in it"
     if len(model.supports) != 1:
         return "it models a cantilever (one support, clamped)"
     sup = model.supports[0]

@@ -4,7 +4,8 @@ name the sections, orientations, supports, loads and probes.
 Each two-node line of a ``.msh`` mesh, and each curve (straight or curved) of a ``.geo``
 geometry, becomes a beam ``<name>.<k>`` (k = 1, 2, ... in file order) with the frame's
 ``elements`` and ``degree``; members meet at shared nodes, where the joint is rigid
-(displacement and rotation are continuous fields). A node group names points: each of its
+(displacement and rotation are continuous fields) unless ``[[frames.joints]]`` pins it or
+releases rotation components (:mod:`beamfx.scene.frame_joints`). A node group names points: each of its
 nodes becomes the end of one member meeting there, so supports, point loads and probes of a
 group are ordinary ``[[supports]]``, ``[[loads]]`` and ``[[probes]]`` entries of
 the model. Example (docs/scenes.md, "Frames from mesh files")::
@@ -26,6 +27,9 @@ the model. Example (docs/scenes.md, "Frames from mesh files")::
     force = [5e3, 0, 0]       # at every node of the group
     [[frames.probes]]
     group = "top"             # probes "top" (one node) or "top.1", "top.2", ...
+    [[frames.joints]]
+    group = "knees"           # a node group whose joints are not rigid
+    type = "pinned"           # or releases = ["rz"], axes = "member" (frame_joints)
 """
 
 from typing import NamedTuple
@@ -35,20 +39,25 @@ import numpy as np
 from ..geometry.curves import Line, SampledCurve
 from ..spec import LOAD_KINDS, Beam, PointLoad, Support
 from .files import named_file
+from .frame_joints import read_joints
 from .limits import unknowns
 from .loads import read_fix
 from .table import SceneError, Table
 
 MESH_SUFFIXES = (".msh", ".geo")
+#: the analyses that take released joints (the others read two fields of the unknowns)
+RELEASE_ANALYSES = ("static", "linear_static", "modal", "arclength")
 
 
 class FrameParts(NamedTuple):
-    """What the ``[[frames]]`` tables add to the model: beams, supports, point loads, probes."""
+    """What the ``[[frames]]`` tables add to the model: beams, supports, point loads, probes
+    and the releases of their non-rigid joints."""
 
     beams: list
     supports: list
     point_loads: list
     probes: dict
+    releases: list  # :class:`~beamfx.spec.Release` of member ends at non-rigid joints
 
 
 def _mesh_path(t, base, limits):
@@ -200,8 +209,9 @@ def _frame(frame, base, limits, read_section):
     probes = {
         k: v for part in _node_tables(frame, "probes", mesh, at, probe) for k, v in part.items()
     }
+    releases = read_joints(frame, _sub_tables, _groups, mesh, name, beams)
     frame.done()
-    return FrameParts(beams, supports, loads, probes)
+    return FrameParts(beams, supports, loads, probes, releases)
 
 
 def read_frames(top, base, limits, read_section, beams=()):
@@ -214,7 +224,7 @@ def read_frames(top, base, limits, read_section, beams=()):
         read_section: ``read_section(table) -> Section`` of a section table.
         beams: the scene's ``[[beams]]``, whose names the members must not take.
     """
-    parts = FrameParts([], [], [], {})
+    parts = FrameParts([], [], [], {}, [])
     names = {b.name.rpartition(".")[0] for b in beams}
     for frame in top.tables("frames"):
         one = _frame(frame, base, limits, read_section)
@@ -233,6 +243,7 @@ def read_frames(top, base, limits, read_section, beams=()):
         parts.beams.extend(one.beams)
         parts.supports.extend(one.supports)
         parts.point_loads.extend(one.point_loads)
+        parts.releases.extend(one.releases)
         twice = set(parts.probes) & set(one.probes)
         if twice:
             raise SceneError(f"{frame.where('probes')}: probe names {sorted(twice)} given twice")
@@ -240,4 +251,4 @@ def read_frames(top, base, limits, read_section, beams=()):
     return parts
 
 
-__all__ = ["FrameParts", "read_frames"]
+__all__ = ["RELEASE_ANALYSES", "FrameParts", "read_frames"]

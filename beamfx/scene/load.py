@@ -18,7 +18,7 @@ from ..solvers.options import option_problems
 from ..spec import Beam, Model
 from .curve import overlap, read_curve
 from .files import read_toml
-from .frames import read_frames
+from .frames import RELEASE_ANALYSES, read_frames
 from .limits import read_limits, unknowns
 from .loads import read_loads, read_masses, read_springs, read_supports
 from .section import read_material, read_section
@@ -78,6 +78,12 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     plane, condense, kin = _model_table(top.table("model", {}))
     at = top.table("analysis", {})
     analysis, settings = _analysis(at, Model(tuple(beams), tuple(supports)), limits)
+    if frames.releases and analysis.name not in RELEASE_ANALYSES:
+        top.fail(
+            "frames",
+            f"pinned or released joints ([[frames.joints]]) work in the analyses "
+            f"{list(RELEASE_ANALYSES)}, not yet in {analysis.name!r}",
+        )
     if analysis.linear:
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
 
@@ -101,6 +107,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         gravity,
         kin,
         point_masses=tuple(masses),
+        releases=tuple(frames.releases),
     )
     _check_points(model, probes, file, data.get("loads", []))
     _check_histories(model, settings, file, data.get("loads", []))
