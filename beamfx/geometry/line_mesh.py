@@ -14,6 +14,9 @@ import numpy as np
 #: meshio cell types read as members and as named nodes
 LINE_TYPES, POINT_TYPES = ("line",), ("vertex",)
 CURVED_TYPES = ("line3", "line4")
+#: nodes closer than MERGE_TOL of the frame's size are one (as beamfx.geometry.mesh joins
+#: vertices); closer than NEAR_TOL but not one: duplicate nodes left unmerged, refused
+MERGE_TOL, NEAR_TOL = 1e-9, 1e-6
 
 
 class LineMesh(NamedTuple):
@@ -54,12 +57,19 @@ def read_line_mesh(path):
     """The :class:`LineMesh` of the file at ``path``: a gmsh ``.msh`` mesh (each line element
     a straight member) or a gmsh ``.geo`` geometry (:func:`read_geo_frame`).
 
+    Nodes at one point are merged (:func:`coincident_nodes`).
+
     Raises:
         ValueError: naming the file, if it does not parse, holds no line element, has
-            non-finite coordinates or zero-length members.
+            non-finite coordinates, zero-length members or nearly coincident nodes.
     """
     if str(path).lower().endswith(".geo"):
-        return read_geo_frame(path)
+        return coincident_nodes(read_geo_frame(path), path)
+    return coincident_nodes(_read_msh(path), path)
+
+
+def _read_msh(path):
+    """The :class:`LineMesh` of a gmsh ``.msh`` file (:func:`read_line_mesh`)."""
     import meshio.gmsh
 
     try:  # the format's reader itself: meshio.read would print and sys.exit on a bad file
@@ -98,6 +108,51 @@ def read_line_mesh(path):
         {k: np.unique(v) for k, v in member_of.items()},
         {k: np.unique(v) for k, v in node_groups.items()},
     )
+
+
+def _describe(mesh, node):
+    """``node k (groups [...], members [...])`` for messages (numbers from 1)."""
+    groups = sorted(g for g, idx in mesh.node_groups.items() if node in idx)
+    members = [k + 1 for k, m in enumerate(mesh.members) if node in m]
+    return f"node {node + 1} (groups {groups}, members {members})"
+
+
+def coincident_nodes(mesh, path):
+    """``mesh`` with nodes at the same point (closer than MERGE_TOL of its size, where
+    :mod:`beamfx.geometry.mesh` joins vertices anyway) merged into the first, in members and
+    node groups; members on merged nodes must stay distinct and of non-zero length.
+
+    Raises:
+        ValueError: naming the nodes, if two nodes of members are nearly but not exactly
+            coincident (closer than NEAR_TOL of the size): the members there would not be
+            joined (a mesh exported without merging its duplicate nodes).
+    """
+    from scipy.spatial import cKDTree
+
+    used = np.unique(mesh.members)
+    size = max(float(np.ptp(mesh.points[used], axis=0).max()), 1e-300)
+    pairs = cKDTree(mesh.points[used]).query_pairs(NEAR_TOL * size, output_type="ndarray")
+    target = np.arange(len(mesh.points))
+    for i, j in sorted(map(tuple, np.sort(pairs, axis=1))):
+        a, b = int(used[i]), int(used[j])
+        d = float(np.linalg.norm(mesh.points[a] - mesh.points[b]))
+        if d > MERGE_TOL * size:
+            raise ValueError(
+                f"{path}: {_describe(mesh, a)} and {_describe(mesh, b)} are {d:.3g} apart "
+                f"({d / size:.1e} of the frame's size): nearly coincident, so the members there "
+                "are not joined. Merge duplicate nodes (gmsh: Coherence Mesh) or move them apart"
+            )
+        target[b] = target[a] if target[b] == b else target[b]
+    while np.any(target[target] != target):
+        target = target[target]
+    if np.all(target == np.arange(len(target))):
+        return mesh
+    members = target[mesh.members]
+    keys = [tuple(sorted(m)) for m in members.tolist()]
+    if any(a == b for a, b in keys) or len(set(keys)) != len(keys):
+        raise ValueError(f"{path}: merging coincident nodes leaves members on one node or twice")
+    groups = {k: np.unique(target[v]) for k, v in mesh.node_groups.items()}
+    return mesh._replace(members=members, node_groups=groups)
 
 
 def read_geo_frame(path, samples=201):
@@ -181,4 +236,10 @@ def write_line_mesh(path, points, members, member_groups, node_groups):
     meshio.write(str(path), mesh, file_format="gmsh22", binary=False)
 
 
-__all__ = ["LineMesh", "read_geo_frame", "read_line_mesh", "write_line_mesh"]
+__all__ = [
+    "LineMesh",
+    "coincident_nodes",
+    "read_geo_frame",
+    "read_line_mesh",
+    "write_line_mesh",
+]
