@@ -17,7 +17,6 @@ named are the releases whose rows carry them. Dense: kept to models of at most
 """
 
 import numpy as np
-from mpi4py import MPI
 
 #: largest number of unknowns decomposed densely (about 1 s for eigh at 3000)
 MAX_DENSE = 4000

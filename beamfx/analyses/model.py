@@ -16,9 +16,9 @@ from ..physics.rotations import np_quaternion
 from ..spec import DOF_NAMES
 from .checks import check_planar
 from .discretisation import Discretised, discretise
+from .dofs import global_size, subspace_dofs
 from .mechanisms import check_mechanisms
 from .releases import HINGE_SIZE, hinge_bcs, hinge_fields, member_rotation
-from .dofs import global_size, subspace_dofs
 
 
 def _check_partition(mesh, comm):

@@ -119,7 +119,7 @@ def hinge_fields(disc, kin, releases):
 
 
 def hinge_rotation(fields, phi):
-    """g = Σ_k ψ_k E_k φ_k: the relative rotation (vector, reference global axes) at each
+    """The relative rotation g = Σ_k ψ_k E_k φ_k (vector, reference global axes) at each
     point of the enriched cells, zero elsewhere."""
     g = 0
     for k in (0, 1):

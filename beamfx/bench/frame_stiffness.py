@@ -28,7 +28,7 @@ class FrameProblem(NamedTuple):
     axes: np.ndarray  # (m, 3, 3) Λ0 of each member (columns x, y, z in global axes)
     fixed: dict  # {node: [dof index 0..5]}
     loads: dict  # {node: (6,) force and moment, global axes}
-    releases: dict = {}  # {(member, end 0|1): (3, k) released joint axes as columns}
+    releases: dict | None = None  # {(member, end 0|1): (3, k) released joint axes as columns}
 
 
 def _bending(L, EI, GA, sign):
@@ -63,7 +63,8 @@ def solve(problem):
     """Nodal displacements and rotations (n, 6) and the reactions {node: (6,)} (force and
     moment, global axes: K u − f at the fixed dofs)."""
     n = len(problem.nodes)
-    hinge = {key: E.shape[1] for key, E in problem.releases.items()}
+    releases = problem.releases or {}
+    hinge = {key: E.shape[1] for key, E in releases.items()}
     size = 6 * n + sum(hinge.values())
     K = np.zeros((size, size))
     first = 6 * n  # a released member end: its rotation = the node's + E φ (φ: own unknowns)
@@ -73,7 +74,7 @@ def solve(problem):
         G = np.zeros((12, size))  # member end dofs (global axes) from the unknowns
         G[:6, 6 * a : 6 * a + 6] = G[6:, 6 * b : 6 * b + 6] = np.eye(6)
         for end in (0, 1):
-            E = problem.releases.get((m, end))
+            E = releases.get((m, end))
             if E is not None:
                 G[6 * end + 3 : 6 * end + 6, first : first + E.shape[1]] = E
                 first += E.shape[1]

@@ -79,10 +79,12 @@ def read_joints(frame, sub_tables, groups, mesh, name, beams):
     """The :class:`~beamfx.spec.Release` of the ``[[frames.joints]]`` of one frame.
 
     Args:
-        frame: the ``[[frames]]`` Table; ``sub_tables(frame, key)`` its sub-tables.
+        frame: the ``[[frames]]`` Table.
+        sub_tables: ``sub_tables(frame, key)``, its sub-tables.
         groups: ``groups(t, key, mesh_groups, kind) -> (name, indices)`` (a missing group fails).
         mesh: the frame's :class:`~beamfx.geometry.line_mesh.LineMesh`.
-        name: the frame's name; ``beams`` its members (``name.k``).
+        name: the frame's name.
+        beams: its members (``name.k``), in file order.
     """
     out, seen = [], {}
     for t in sub_tables(frame, "joints"):

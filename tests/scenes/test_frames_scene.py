@@ -211,3 +211,178 @@ def test_curved_geo_members_follow_the_gmsh_curve(tmp_path):
     assert beams[1].curve.length == pytest.approx(np.pi * 2, rel=1e-8)
     run = run_scene(tmp_path / "scene.toml", tmp_path / "out", log=lambda m: None)
     assert run["reaction_balance"]["force"] < 1e-9
+
+
+# a portal in the x-z plane: columns 1-2 and 4-3 (3 m), a beam 2-3 (4 m), square columns
+PORTAL_POINTS = [[0, 0, 0], [0, 0, 3], [4, 0, 3], [4, 0, 0]]
+PORTAL_MEMBERS = [[0, 1], [1, 2], [3, 2]]
+PORTAL = """
+[material]
+E = 210e9
+nu = 0.3
+[[frames]]
+name = "p"
+mesh = "portal.msh"
+elements = 2
+degree = 3
+[[frames.members]]
+group = "columns"
+section = { type = "rectangle", h = 0.25, w = 0.25 }
+[[frames.members]]
+group = "beam"
+section = { type = "rectangle", h = 0.4, w = 0.2 }
+[[frames.supports]]
+group = "feet"
+fix = FIX
+[[frames.loads]]
+group = "left"
+force = [1e4, 0, 0]
+[[frames.joints]]
+JOINT
+[model]
+plane = "PLANE"
+[analysis]
+type = "linear_static"
+"""
+PINNED = 'group = "knees"\ntype = "pinned"'
+
+
+@pytest.fixture
+def portal(tmp_path):
+    """``portal(joint, fix, plane) -> scene path`` of the portal with the joint table."""
+
+    def write(joint=PINNED, fix='"all"', plane="auto"):
+        groups = {"columns": [0, 2], "beam": [1]}
+        nodes = {"feet": [0, 3], "knees": [1, 2], "left": [1]}
+        write_line_mesh(tmp_path / "portal.msh", PORTAL_POINTS, PORTAL_MEMBERS, groups, nodes)
+        text = PORTAL.replace("JOINT", joint).replace("FIX", fix).replace("PLANE", plane)
+        (tmp_path / "scene.toml").write_text(text)
+        return tmp_path / "scene.toml"
+
+    return write
+
+
+@pytest.mark.parametrize("plane", ["auto", "none"])
+def test_portal_with_pinned_knees_equals_the_hand_solution(portal, tmp_path, plane):
+    """Both knees hinged: the clamped columns are Timoshenko cantilevers (tip stiffness k_c)
+    joined by an axial link (k_b = EA/L): the far column takes H2 = F/(2 + k_c/k_b), the
+    loaded one H1 = F − H2, the base moments are H·h and nothing is vertical. Exact (P3
+    holds the cantilevers and the release is exact): 1e-9."""
+    path = portal('group = "knees"\nreleases = ["ry"]', plane=plane)  # y: normal to the plane
+    spec = load_scene(path).model
+    # members in file order (groups first): p.1 and p.2 the columns, p.3 the beam
+    assert [r.at for r in spec.releases] == ["p.3:start", "p.3:end"]
+    _, GA, _, _, EI, _ = spec.beams[0].section.stiffnesses()
+    k_c = 1 / (3**3 / (3 * EI) + 3 / GA)
+    k_b = spec.beams[2].section.stiffnesses()[0] / 4
+    H2 = 1e4 / (2 + k_c / k_b)
+    run = run_scene(path, tmp_path / "out", log=lambda m: None)
+    left, right = run["reactions"]["p.1:start"], run["reactions"]["p.2:start"]
+    assert left["force"] == pytest.approx([-(1e4 - H2), 0, 0], rel=1e-9, abs=1e-9 * 1e4)
+    assert right["force"] == pytest.approx([-H2, 0, 0], rel=1e-9, abs=1e-9 * 1e4)
+    assert left["moment"][1] == pytest.approx(-3 * (1e4 - H2), rel=1e-9)
+    assert right["moment"][1] == pytest.approx(-3 * H2, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "joint, fix, named",
+    [  # 3D: the beam pinned at both ends spins about its own axis, so it does with only
+        # its torsion released at both ends
+        (PINNED, '"all"', ["p node 2 (group 'knees')", "p node 3 (group 'knees')"]),
+        (
+            'group = "knees"\nreleases = ["rx"]\naxes = "member"\nmembers = "beam"',
+            '"all"',
+            ["p node 2 (group 'knees')", "p node 3 (group 'knees')"],
+        ),
+    ],
+)
+def test_mechanisms_are_found_before_the_solve_naming_the_joints(
+    portal, tmp_path, joint, fix, named
+):
+    with pytest.raises(ValueError, match="leave 1 mechanism") as e:
+        run_scene(portal(joint, fix, "none"), tmp_path / "out", log=lambda m: None)
+    assert all(n in str(e.value) for n in named), str(e.value)
+
+
+def test_member_axes_and_torsion_release_at_one_end(portal, tmp_path):
+    """The beam's torsion released at one knee only is no mechanism (the other end holds
+    it); with axes = "member" the release is about the beam's axis (x)."""
+    joint = 'group = "left"\nreleases = ["rx"]\naxes = "member"\nmembers = "beam"'
+    spec = load_scene(portal(joint)).model
+    (rel,) = spec.releases
+    assert rel.at == "p.3:start" and rel.released == ("rx",)
+    assert np.allclose(rel.axes[0], [1, 0, 0])
+    run = run_scene(portal(joint), tmp_path / "out", log=lambda m: None)
+    assert run["reaction_balance"]["force"] < 1e-9
+
+
+@pytest.mark.parametrize(
+    "joint, message",
+    [
+        ('group = "knees"\nreleases = ["rw"]', "joints[0].releases: ['rw']: give distinct"),
+        ('group = "knees"\ntype = "pinned"\nreleases = ["rz"]', "joints[0].type: give either"),
+        ('group = "knees"\ntype = "hinge"', "joints[0].type"),
+        ('group = "knees"', "joints[0].type: missing; allowed: ['rigid', 'pinned']"),
+        (
+            'group = "elbows"\ntype = "pinned"',
+            "joints[0].group: the mesh has no node (point) group 'elbows'",
+        ),
+        (
+            'group = "knees"\ntype = "pinned"\nmembers = "girders"',
+            "joints[0].members: the mesh has no member",
+        ),
+        (
+            'group = "knees"\ntype = "pinned"\naxes = { x = [1, 0, 0], y = [2, 0, 0] }',
+            "joints[0].axes: x must be",
+        ),
+        ('group = "knees"\ntype = "pinned"\naxes = "local"', "joints[0].axes"),
+    ],
+)
+def test_bad_joints_name_their_key(portal, joint, message):
+    assert message in _error(portal(joint))
+
+
+def test_joints_in_an_analysis_that_cannot_take_them_are_refused(portal, tmp_path):
+    path = portal()
+    path.write_text(path.read_text().replace('type = "linear_static"', 'type = "buckling"'))
+    assert "frames: pinned or released joints" in _error(path)
+
+
+def test_nearly_coincident_nodes_are_refused_and_coincident_ones_merged(tripod, tmp_path):
+    """A mesh exported without merging its nodes: an exact duplicate at the apex is one node
+    (as the mesh builder joins it anyway); one 1e-8 off is refused naming both nodes, their
+    groups and members, since the members there would not be joined."""
+    points = [*POINTS, [0.7, 0.7, 2.0]]
+    write_line_mesh(
+        tmp_path / "tripod.msh",
+        points,
+        [[0, 3], [1, 4], [2, 3]],
+        {"legs": [0, 1, 2]},
+        {"feet": [0, 1, 2], "apex": [4]},
+    )
+    (tmp_path / "scene.toml").write_text(SCENE.replace("KIN", "linear"))
+    mesh = load_scene(tmp_path / "scene.toml")
+    assert mesh.model.beams[1].curve.length == pytest.approx(
+        np.linalg.norm(np.subtract(POINTS[3], POINTS[1]))
+    )
+    points[4] = [0.7, 0.7, 2.0 + 1e-8]
+    write_line_mesh(
+        tmp_path / "tripod.msh",
+        points,
+        [[0, 3], [1, 4], [2, 3]],
+        {"legs": [0, 1, 2]},
+        {"feet": [0, 1, 2], "apex": [4]},
+    )
+    message = _error(tmp_path / "scene.toml")
+    assert (
+        "frames[0].mesh" in message and "tripod.msh: node 4 (groups [], members [1, 3])" in message
+    )
+    assert "node 5 (groups ['apex'], members [2]) are 1e-08 apart" in message
+
+
+def test_a_planar_sway_mechanism_is_found(portal, tmp_path):
+    """Feet and knees hinged about y (normal to the plane): the portal sways freely."""
+    joint, fix = 'group = "knees"\nreleases = ["ry"]', '["ux", "uy", "uz", "rx", "rz"]'
+    with pytest.raises(ValueError, match="leave 1 mechanism") as e:
+        run_scene(portal(joint, fix), tmp_path / "out", log=lambda m: None)
+    assert "p node 2 (group 'knees')" in str(e.value)
