@@ -32,7 +32,7 @@ def _released(t):
         if "type" in t.data:
             t.fail("type", "give either type or releases, not both")
         rel = t.get("releases", list)
-        bad = [r for r in rel if r not in RELEASES]
+        bad = [r for r in rel if not isinstance(r, str) or r not in RELEASES]
         if bad or not rel or len(set(rel)) != len(rel):
             t.fail("releases", f"{rel}: give distinct components of {list(RELEASES)}")
         return tuple(r for r in RELEASES if r in rel)
@@ -45,11 +45,16 @@ def _explicit_axes(t):
     table = t.table("axes")
     x, y = np.array(table.get("x", "vec3")), np.array(table.get("y", "vec3"))
     table.done()
-    nx = np.linalg.norm(x)
-    y = y - np.dot(y, x) / max(nx**2, 1e-300) * x
-    if nx == 0 or np.linalg.norm(y) < 1e-9 * max(np.linalg.norm(table.data["y"]), 1e-300):
-        t.fail("axes", "x must be non-zero and y not parallel to it")
-    x, y = x / nx, y / np.linalg.norm(y)
+    scale = np.abs(np.r_[x, y]).max()
+    if not 0 < scale < 1e300 or np.abs(x).max() == 0:
+        table.fail("x", f"{list(x)}: give a non-zero axis of moderate size (with y)")
+    x, y = x / scale, y / scale  # no overflow in the norms below
+    x = x / np.linalg.norm(x)
+    size = np.linalg.norm(y)
+    y = y - np.dot(y, x) * x
+    if np.linalg.norm(y) <= 1e-9 * size or size == 0:
+        table.fail("y", f"is zero or parallel to {table.path}.x; give a direction normal to x")
+    y = y / np.linalg.norm(y)
     return (tuple(x), tuple(y), tuple(np.cross(x, y)))
 
 

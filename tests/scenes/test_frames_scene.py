@@ -333,7 +333,7 @@ def test_member_axes_and_torsion_release_at_one_end(portal, tmp_path):
         ),
         (
             'group = "knees"\ntype = "pinned"\naxes = { x = [1, 0, 0], y = [2, 0, 0] }',
-            "joints[0].axes: x must be",
+            "joints[0].axes.y: is zero or parallel to frames[0].joints[0].axes.x",
         ),
         ('group = "knees"\ntype = "pinned"\naxes = "local"', "joints[0].axes"),
     ],

@@ -617,3 +617,68 @@ def test_the_command_says_what_is_wrong_without_a_traceback(folder):
         assert "Traceback" not in p.stderr and p.stderr.startswith(
             f"beamfx: error: {folder / name}: beams["
         )
+
+
+#: a frame scene ([[frames]] from a mesh file, beamfx.scene.frames) with every frame key
+FRAME_BASE = {
+    "material": {"E": 2.1e11, "nu": 0.3, "rho": 7850.0},
+    "frames": [
+        {
+            "name": "p",
+            "mesh": "portal.msh",
+            "elements": 1,
+            "degree": 2,
+            "members": [
+                {"group": "columns", "section": {"type": "tube", "d": 0.1, "d_inner": 0.08}},
+                {
+                    "group": "beam",
+                    "section": {"type": "rectangle", "h": 0.2, "w": 0.1},
+                    "orientation": [0, 1, 1],
+                    "twist_deg": 5.0,
+                },
+            ],
+            "supports": [{"group": "feet", "fix": "all"}],
+            "loads": [{"group": "knees", "force": [1e3, 0, 0], "moment": [0, 0, 1.0]}],
+            "probes": [{"group": "knees", "name": "k"}],
+            "joints": [
+                {
+                    "group": "knees",
+                    "releases": ["ry"],
+                    "axes": {"x": [1, 0, 0], "y": [0, 1, 0]},
+                    "members": "beam",
+                }
+            ],
+        }
+    ],
+    "analysis": {"type": "static", "steps": 2},
+}
+
+
+def test_fuzzed_frame_keys_are_refused_by_name_or_pass_finite(folder):
+    """Every key of a [[frames]] scene (members, supports, loads, probes, joints) set to
+    hostile values or removed: refused naming the file and the key, or valid and finite."""
+    from beamfx.geometry.line_mesh import write_line_mesh
+
+    points = [[0, 0, 0], [0, 0, 3], [4, 0, 3], [4, 0, 0]]
+    groups, nodes = {"columns": [0, 2], "beam": [1]}, {"feet": [0, 3], "knees": [1, 2]}
+    write_line_mesh(folder / "portal.msh", points, [[0, 1], [1, 2], [3, 2]], groups, nodes)
+    path = folder / "frame.toml"
+    path.write_text(toml_text(FRAME_BASE))
+    scene = check(path)
+    assert not isinstance(scene, Exception), scene
+    assert len(scene.model.releases) == 2 and finite(scene.model)
+    generated, wrong = 0, []
+    for p, _, _ in leaves(FRAME_BASE):
+        for value in [*HOSTILE, REMOVE] if "#" not in p else COMPONENT:
+            path = folder / f"f{generated}.toml"
+            path.write_text(toml_text(mutated(FRAME_BASE, p, value)))
+            result, generated = check(path), generated + 1
+            label = f"{p}={'<removed>' if value is REMOVE else repr(value)}"
+            if isinstance(result, SceneError):
+                if not _named(result, path, p.split("#")[0], removed=value is REMOVE):
+                    wrong.append(f"{label}: {result}")
+            elif isinstance(result, Exception) or not finite(result.model):
+                wrong.append(f"{label}: {result if isinstance(result, Exception) else 'nan'}")
+            path.unlink()
+    assert not wrong, "\n".join(wrong)
+    assert generated > 250, generated
