@@ -32,8 +32,9 @@ class ModalResult(NamedTuple):
 def mass_ufl(model, rotary="full"):
     """The mass form of ``model`` about its current state (UFL): the beams' and the point
     masses' (``rotary`` applies to the sections only; a point mass keeps its inertia)."""
-    v = ufl.split(ufl.TestFunction(model.W))
-    dw = ufl.split(ufl.TrialFunction(model.W))
+    # displacement and rotation (a third field, the hinges of released joints, has no mass)
+    v = ufl.split(ufl.TestFunction(model.W))[:2]
+    dw = ufl.split(ufl.TrialFunction(model.W))[:2]
     rot = ufl.split(model.w)[1]
     d = model.discretisation
     if d.matrices is None:

@@ -124,3 +124,36 @@ def test_a_hinge_turned_by_90_degrees_stays_moment_free():
     assert abs(reactions["B:end"]["force"][2]) < 1e-6 * F
     _, rigid = _solve(replace(spec, releases=()), 4)
     assert abs(rigid["B:end"]["force"][2]) > 0.1 * F
+
+
+def test_modes_of_a_beam_released_at_clamped_ends_are_those_of_a_pinned_beam():
+    """A beam clamped at both ends with its bending released there (the hinge unknowns)
+    against the same beam on pinned supports: the same discrete space, so without the
+    rotary inertia (a hinge carries none, and torsion is about the skew axis) the frequencies
+    agree to round-off."""
+    from mpi4py import MPI
+
+    from beamfx.analyses.modal import solve_modes
+    from beamfx.analyses.model import BeamModel
+
+    section = tube(210e9, 80e9, 7850.0, 0.05, 0.04)
+    beam = Beam("b", Line((0.0, 0.0, 0.0), (2.0, 0.3, 0.1)), section, 6, 2)
+    ends = ("b:start", "b:end")
+    clamped = Model(
+        (beam,),
+        tuple(Support(at, ("ux", "uy", "uz", "rx", "ry", "rz")) for at in ends),
+        kinematics=Kinematics(False),
+        releases=tuple(Release(at, ("ry", "rz")) for at in ends),
+    )
+    pinned = replace(
+        clamped,
+        supports=tuple(Support(at, ("ux", "uy", "uz", "rx")) for at in ends),
+        releases=(),
+    )
+    freqs = [
+        np.sort(solve_modes(BeamModel(m, MPI.COMM_WORLD), 6, rotary="none").omega)
+        for m in (clamped, pinned)
+    ]
+    assert np.allclose(freqs[0], freqs[1], rtol=1e-9, atol=0)
+    rigid = np.sort(solve_modes(BeamModel(replace(clamped, releases=())), 6, rotary="none").omega)
+    assert rigid[0] > 1.5 * freqs[0][0]
