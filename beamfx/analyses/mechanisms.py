@@ -7,7 +7,8 @@ directions that move the hinge unknowns (:mod:`beamfx.analyses.releases`), while
 rigid-body motions of a free structure (which :func:`~beamfx.analyses.checks.check_supported`
 answers for) leave them at zero.
 
-The check: K (Dirichlet rows identity), Jacobi-scaled to S = D^{-1/2} K D^{-1/2} (unit
+The check: K with unit section stiffnesses (:func:`unit_stiffness`; Dirichlet rows
+identity), Jacobi-scaled to S = D^{-1/2} K D^{-1/2} (unit
 diagonal, so the threshold is scale-free), gathered on rank 0 and decomposed densely
 (``numpy.linalg.eigh``); its null space N = eigenvectors with λ < 1e-10 (round-off of a
 unit-diagonal matrix is ~1e-15, the smallest eigenvalue of a sound slender frame ~1e-8 or
@@ -15,6 +16,8 @@ more). The number of mechanisms is the rank of N restricted to the hinge rows, a
 named are the releases whose rows carry them. Dense: kept to models of at most
 :data:`MAX_DENSE` unknowns (a frame of a few hundred members); larger ones are not checked.
 """
+
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -78,6 +81,26 @@ def _global_rows(W, local):
     return {r: sorted(set(g)) for r, g in merged.items() if g}
 
 
+@contextmanager
+def unit_stiffness(model):
+    """Within: every section stiffness (and the quaternion norm penalty) 1. Whether a
+    mechanism exists depends on the joints and the geometry, not on the stiffness values;
+    with them, a rigid arm (1e6 times stiffer than its member) or a stiff member next to a
+    slender one would push genuine eigenvalues of the scaled stiffness to the round-off."""
+    d = model.discretisation
+    if d.matrices is not None:  # 6×6 section matrices: kept as they are
+        yield
+        return
+    saved, penalty = d.stiffness.x.array.copy(), float(model.k_penalty.value)
+    d.stiffness.x.array[:] = 1.0
+    model.k_penalty.value = 1.0
+    try:
+        yield
+    finally:
+        d.stiffness.x.array[:] = saved
+        model.k_penalty.value = penalty
+
+
 def check_mechanisms(model):
     """Raise ValueError naming the joints if the releases of ``model`` (a
     :class:`~beamfx.analyses.model.BeamModel` at its reference state) leave a mechanism.
@@ -98,7 +121,8 @@ def check_mechanisms(model):
         return 0
     J = compile_form(model.J)
     A = fp.create_matrix(J)
-    assemble_tangent(A, J, model.bcs)
+    with unit_stiffness(model):
+        assemble_tangent(A, J, model.bcs)
     K = _gather_dense(A, comm)
     A.destroy()
     rows = _global_rows(model.W, hinge_dofs(model.W, model.hinges))

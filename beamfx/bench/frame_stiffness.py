@@ -5,7 +5,8 @@ A reference for beamfx's linear kinematics on frames of straight prismatic membe
 the joints: there the exact Timoshenko solution is cubic in the displacement and quadratic in
 the rotation along each member, which P3 elements hold exactly, so beamfx must agree to
 round-off. A released member end (``Model.releases``) has its own rotation, the node's plus
-the released components along the joint axes (unknowns of their own). Member axes are beamfx's (:func:`~beamfx.geometry.frames.frame_from_tangent`: x the
+the released components along the joint axes (unknowns of their own); an offset end
+(``FrameProblem.offsets``) hangs on its node by a rigid arm. Member axes are beamfx's (:func:`~beamfx.geometry.frames.frame_from_tangent`: x the
 tangent, z the orientation vector made normal to it, y = z × x), stiffnesses (EA, GA_y, GA_z,
 GJ, EI_y, EI_z) those of the member's section: EI_z and GA_y act in the x–y plane,
 Φ_y = 12 EI_z / (GA_y L²), and EI_y, GA_z in the x–z plane.
@@ -29,6 +30,7 @@ class FrameProblem(NamedTuple):
     fixed: dict  # {node: [dof index 0..5]}
     loads: dict  # {node: (6,) force and moment, global axes}
     releases: dict | None = None  # {(member, end 0|1): (3, k) released joint axes as columns}
+    offsets: dict | None = None  # {(member, end 0|1): (3,) rigid arm from the node to the end}
 
 
 def _bending(L, EI, GA, sign):
@@ -59,6 +61,11 @@ def member_stiffness(L, C):
     return k
 
 
+def _hat(r):
+    """The matrix of r × ·."""
+    return np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+
+
 def solve(problem):
     """Nodal displacements and rotations (n, 6) and the reactions {node: (6,)} (force and
     moment, global axes: K u − f at the fixed dofs)."""
@@ -68,8 +75,10 @@ def solve(problem):
     size = 6 * n + sum(hinge.values())
     K = np.zeros((size, size))
     first = 6 * n  # a released member end: its rotation = the node's + E φ (φ: own unknowns)
+    offsets = problem.offsets or {}
     for m, ((a, b), C, lam) in enumerate(zip(problem.members, problem.stiffness, problem.axes)):
-        L = np.linalg.norm(problem.nodes[b] - problem.nodes[a])
+        ends = [problem.nodes[n] + offsets.get((m, e), 0.0) for e, n in enumerate((a, b))]
+        L = np.linalg.norm(ends[1] - ends[0])
         T = np.kron(np.eye(4), lam.T)
         G = np.zeros((12, size))  # member end dofs (global axes) from the unknowns
         G[:6, 6 * a : 6 * a + 6] = G[6:, 6 * b : 6 * b + 6] = np.eye(6)
@@ -78,6 +87,9 @@ def solve(problem):
             if E is not None:
                 G[6 * end + 3 : 6 * end + 6, first : first + E.shape[1]] = E
                 first += E.shape[1]
+            r = offsets.get((m, end))
+            if r is not None:  # a rigid arm: u_end = u_node + θ_end × r
+                G[6 * end : 6 * end + 3] -= _hat(r) @ G[6 * end + 3 : 6 * end + 6]
         K += G.T @ T.T @ member_stiffness(L, C) @ T @ G
     f = np.zeros(size)
     for node, load in problem.loads.items():

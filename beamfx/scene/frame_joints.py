@@ -15,15 +15,30 @@ is released has a free rotation, which the mechanism check reports)::
     axes = "member"            # "global" (default), "member" (each member end's section
                                # axes: x along the member), or { x = [...], y = [...] }
     members = "rafters"        # optional: release only these members' ends
+
+``[[frames.offsets]]``: eccentric connections. The ends of a member group sit at ``offset``
+(global axes) from their nodes, joined to them by rigid arms (stiff massless beams, so
+rigid at any rotation up to a compliance 1e-6 of the member's); a release at such an end
+acts at the node, between the arm and the node::
+
+    [[frames.offsets]]
+    group = "beams"
+    end = "both"               # "start", "end" or "both" (default)
+    offset = [0, 0, 0.2]       # from the node to the member's end
 """
 
 import numpy as np
 
+from ..geometry.curves import Line
 from ..geometry.frames import frame_from_tangent
-from ..spec import Release
+from ..physics.sections import Section
+from ..spec import Beam, Release
 
 RELEASES = ("rx", "ry", "rz")
 JOINT_TYPES = ("rigid", "pinned")
+ENDS = ("start", "end")
+#: a rigid arm's stiffnesses over its member's largest (its compliance is 1e-6 of theirs)
+ARM_STIFFNESS = 1e6
 
 
 def _released(t):
@@ -80,7 +95,66 @@ def _ends_at(mesh, node):
     return [(k, e) for k, m in enumerate(mesh.members) for e in (0, 1) if int(m[e]) == node]
 
 
-def read_joints(frame, sub_tables, groups, mesh, name, beams):
+def read_offsets(frame, sub_tables, groups, mesh):
+    """{(member, end 0|1): offset (3,)} of the ``[[frames.offsets]]`` of one frame: the vector
+    from the node to the member's end (global axes), bridged by a rigid arm."""
+    out = {}
+    for t in sub_tables(frame, "offsets"):
+        group, members = groups(t, "group", mesh.member_groups, "member (line)")
+        end = t.get("end", str, "both", choices=(*ENDS, "both"))
+        offset = np.array(t.get("offset", "vec3"))
+        t.done()
+        if not np.any(offset):
+            continue
+        for k in (int(x) for x in members):
+            if mesh.curves and mesh.curves[k] is not None:
+                t.fail("group", f"member {k + 1} of {group!r} is curved: offsets need lines")
+            for e in (0, 1) if end == "both" else (ENDS.index(end),):
+                if (k, e) in out:
+                    t.fail("group", f"member {k + 1} of {group!r} has two offsets at its {ENDS[e]}")
+                out[(k, e)] = offset
+    return out
+
+
+def end_points(name, offsets):
+    """``point(k, e)``: the point name of member k's end e at its node: the member's end, or
+    the node end of its rigid arm (``<name>.<k>.arm_<end>:start``)."""
+
+    def point(k, e):
+        if (k, e) in offsets:
+            return f"{name}.{k + 1}.arm_{ENDS[e]}:start"
+        return f"{name}.{k + 1}:{ENDS[e]}"
+
+    return point
+
+
+def offset_line(t, mesh, k, offsets):
+    """The straight member k between its offset ends (None if it has no offset)."""
+    if not any((k, e) in offsets for e in (0, 1)):
+        return None
+    a, b = (mesh.points[mesh.members[k][e]] + offsets.get((k, e), 0.0) for e in (0, 1))
+    if np.linalg.norm(b - a) <= 1e-9 * max(np.linalg.norm(mesh.points[mesh.members[k]]), 1.0):
+        t.fail("offsets", f"member {k + 1}'s offsets bring its ends together")
+    return Line(tuple(a), tuple(b))
+
+
+def rigid_arms(name, beams, mesh, offsets, degree):
+    """The rigid arms of the offset member ends: beams ``<name>.<k>.arm_<end>`` from the node
+    to the member's end, one element, massless, isotropic, :data:`ARM_STIFFNESS` times
+    stiffer than their member (a stiff Simo–Reissner beam: rigid in the limit, at any
+    rotation)."""
+    arms = []
+    for (k, e), offset in sorted(offsets.items(), key=lambda x: x[0]):
+        node = mesh.points[mesh.members[k][e]]
+        C = beams[k].section.stiffnesses()
+        f, m = ARM_STIFFNESS * C[:3].max(), ARM_STIFFNESS * C[3:].max()
+        section = Section(f, f, f, m, m, m)
+        line = Line(tuple(node), tuple(node + offset))
+        arms.append(Beam(f"{name}.{k + 1}.arm_{ENDS[e]}", line, section, 1, degree))
+    return arms
+
+
+def read_joints(frame, sub_tables, groups, mesh, name, beams, point=None):
     """The :class:`~beamfx.spec.Release` of the ``[[frames.joints]]`` of one frame.
 
     Args:
@@ -90,7 +164,10 @@ def read_joints(frame, sub_tables, groups, mesh, name, beams):
         mesh: the frame's :class:`~beamfx.geometry.line_mesh.LineMesh`.
         name: the frame's name.
         beams: its members (``name.k``), in file order.
+        point: ``point(k, end)``, the point name of a member end at its node
+            (:func:`end_points`); default: the member's end.
     """
+    point = point or end_points(name, {})
     out, seen = [], {}
     for t in sub_tables(frame, "joints"):
         group, nodes = groups(t, "group", mesh.node_groups, "node (point)")
@@ -113,7 +190,7 @@ def read_joints(frame, sub_tables, groups, mesh, name, beams):
                 rows = _member_axes(beams[k], end) if axes is None else axes
                 out.append(
                     Release(
-                        f"{name}.{k + 1}:{('start', 'end')[end]}",
+                        point(k, end),
                         released,
                         tuple(tuple(float(v) for v in r) for r in rows),
                         f"{name} node {n + 1} (group {group!r})",
@@ -122,4 +199,13 @@ def read_joints(frame, sub_tables, groups, mesh, name, beams):
     return out
 
 
-__all__ = ["JOINT_TYPES", "RELEASES", "read_joints"]
+__all__ = [
+    "ARM_STIFFNESS",
+    "JOINT_TYPES",
+    "RELEASES",
+    "end_points",
+    "offset_line",
+    "read_joints",
+    "read_offsets",
+    "rigid_arms",
+]

@@ -30,6 +30,9 @@ the model. Example (docs/scenes.md, "Frames from mesh files")::
     [[frames.joints]]
     group = "knees"           # a node group whose joints are not rigid
     type = "pinned"           # or releases = ["rz"], axes = "member" (frame_joints)
+    [[frames.offsets]]
+    group = "legs"            # eccentric ends: rigid arms from the nodes (frame_joints)
+    offset = [0, 0, 0.1]
 """
 
 from typing import NamedTuple
@@ -39,7 +42,7 @@ import numpy as np
 from ..geometry.curves import Line, SampledCurve
 from ..spec import LOAD_KINDS, Beam, PointLoad, Support
 from .files import named_file
-from .frame_joints import read_joints
+from .frame_joints import end_points, offset_line, read_joints, read_offsets, rigid_arms
 from .limits import unknowns
 from .loads import read_fix
 from .table import SceneError, Table
@@ -125,12 +128,13 @@ def _member_curve(mesh, k):
     return SampledCurve(tuple(map(tuple, xyz)))
 
 
-def _node_points(mesh, name):
-    """The point name ``<name>.<k>:start|end`` of each node: the first member meeting there."""
+def _node_points(mesh, point):
+    """The point name of each node: ``point(k, end)`` of the first member meeting there
+    (``<name>.<k>:start|end``, or the node end of its rigid arm)."""
     at = {}
     for k, (a, b) in enumerate(mesh.members):
-        at.setdefault(int(a), f"{name}.{k + 1}:start")
-        at.setdefault(int(b), f"{name}.{k + 1}:end")
+        at.setdefault(int(a), point(k, 0))
+        at.setdefault(int(b), point(k, 1))
     return at
 
 
@@ -174,10 +178,11 @@ def _frame(frame, base, limits, read_section):
     elements = frame.get("elements", int, 1, positive=True)
     degree = frame.get("degree", int, 2, choices=(1, 2, 3, 4))
     section, orientation, twist = _members(frame, mesh, name, read_section)
+    offsets = read_offsets(frame, _sub_tables, _groups, mesh)
     beams = [
         Beam(
             f"{name}.{k + 1}",
-            _member_curve(mesh, k),
+            offset_line(frame, mesh, k, offsets) or _member_curve(mesh, k),
             section[k],
             elements,
             degree,
@@ -186,7 +191,8 @@ def _frame(frame, base, limits, read_section):
         )
         for k, m in enumerate(mesh.members)
     ]
-    at = _node_points(mesh, name)
+    point = end_points(name, offsets)
+    at = _node_points(mesh, point)
 
     def support(t, group, points):
         return [Support(p, read_fix(t)) for p in points]
@@ -209,9 +215,10 @@ def _frame(frame, base, limits, read_section):
     probes = {
         k: v for part in _node_tables(frame, "probes", mesh, at, probe) for k, v in part.items()
     }
-    releases = read_joints(frame, _sub_tables, _groups, mesh, name, beams)
+    releases = read_joints(frame, _sub_tables, _groups, mesh, name, beams, point)
+    arms = rigid_arms(name, beams, mesh, offsets, degree)
     frame.done()
-    return FrameParts(beams, supports, loads, probes, releases)
+    return FrameParts(beams + arms, supports, loads, probes, releases)
 
 
 def read_frames(top, base, limits, read_section, beams=()):

@@ -157,3 +157,92 @@ def test_modes_of_a_beam_released_at_clamped_ends_are_those_of_a_pinned_beam():
     assert np.allclose(freqs[0], freqs[1], rtol=1e-9, atol=0)
     rigid = np.sort(solve_modes(BeamModel(replace(clamped, releases=())), 6, rotary="none").omega)
     assert rigid[0] > 1.5 * freqs[0][0]
+
+
+ECCENTRIC = """
+[material]
+E = 210e9
+nu = 0.3
+[[frames]]
+name = "p"
+mesh = "portal.msh"
+elements = 2
+degree = 3
+[[frames.members]]
+group = "columns"
+section = { type = "rectangle", h = 0.3, w = 0.2 }
+[[frames.members]]
+group = "beam"
+section = { type = "tube", d = 0.3, d_inner = 0.25 }
+[[frames.offsets]]
+group = "beam"
+offset = [0, 0.1, 0.2]
+[[frames.supports]]
+group = "feet"
+fix = "all"
+[[frames.loads]]
+group = "left"
+force = [1e4, 2e3, -5e3]
+moment = [1e3, 0, 2e3]
+[model]
+plane = "none"
+[analysis]
+type = "linear_static"
+"""
+PORTAL_NODES = np.array([[0, 0, 0], [0, 0, 3], [4, 0, 3], [4, 0, 0]], float)
+
+
+def _eccentric_exact(spec, offset, released):
+    """The exact portal: columns 0-1 and 3-2, the beam 1-2 on rigid arms ``offset`` at both
+    ends (released about y at both knees if ``released``), clamped feet, the load at node 1."""
+    from beamfx.geometry.frames import frame_from_tangent
+
+    members = np.array([[0, 1], [3, 2], [1, 2]])
+    beams = {b.name: b for b in spec.beams}
+    C = [beams[f"p.{k}"].section.stiffnesses() for k in (1, 2, 3)]
+    axes = []
+    for k, (a, b) in enumerate(members):
+        d = PORTAL_NODES[b] - PORTAL_NODES[a]
+        axes.append(frame_from_tangent(d / np.linalg.norm(d), beams[f"p.{k + 1}"].orientation))
+    load = np.r_[spec.point_loads[0].force, spec.point_loads[0].moment]
+    ey = np.array([[0.0], [1.0], [0.0]])
+    return frame_stiffness.FrameProblem(
+        PORTAL_NODES,
+        members,
+        np.array(C),
+        np.array(axes),
+        {0: list(range(6)), 3: list(range(6))},
+        {1: load},
+        {(2, 0): ey, (2, 1): ey} if released else {},
+        {(2, 0): np.asarray(offset), (2, 1): np.asarray(offset)},
+    )
+
+
+@pytest.mark.parametrize("released", [False, True])
+def test_eccentric_portal_equals_the_exact_frame_with_rigid_arms(tmp_path, released):
+    """The beam's ends sit off the knees, on rigid arms (stiff beams, 1e6 times their
+    member's stiffness): beamfx's linear solution equals the exact frame with rigid offsets
+    (and with the beam hinged about y at the knees, at the node end of the arms) to 1e-6,
+    the arms' relative compliance; without the offsets it differs by more than 1e-3."""
+    from beamfx.geometry.line_mesh import write_line_mesh
+
+    groups, nodes = {"columns": [0, 2], "beam": [1]}, {"feet": [0, 3], "knees": [1, 2], "left": [1]}
+    members = [[0, 1], [1, 2], [3, 2]]
+    write_line_mesh(tmp_path / "portal.msh", PORTAL_NODES, members, groups, nodes)
+    text = ECCENTRIC
+    if released:
+        text += '[[frames.joints]]\ngroup = "knees"\nreleases = ["ry"]\nmembers = "beam"\n'
+    (tmp_path / "scene.toml").write_text(text)
+    spec = load_scene(tmp_path / "scene.toml").model
+    assert [b.name for b in spec.beams][3:] == ["p.3.arm_start", "p.3.arm_end"]
+    if released:
+        assert [r.at for r in spec.releases] == ["p.3.arm_start:start", "p.3.arm_end:start"]
+    u, reactions, _ = frame_peers.beamfx_frame(spec)
+    problem = _eccentric_exact(spec, (0, 0.1, 0.2), released)
+    exact, exact_reactions = frame_stiffness.solve(problem)
+    index = frame_stiffness.problem_from_model(spec).nodes  # beamfx_frame's node order
+    order = [int(np.argmin(np.linalg.norm(index - x, axis=1))) for x in PORTAL_NODES]
+    mine = {i: reactions[order[i]] for i in (0, 3)}
+    assert max(frame_peers.differences(u[order], mine, exact, exact_reactions)) < 1e-6
+    concentric = frame_stiffness.solve(problem._replace(offsets={}))
+    assert min(frame_peers.differences(exact, exact_reactions, *concentric)) > 1e-3
