@@ -19,7 +19,10 @@ is released has a free rotation, which the mechanism check reports)::
 ``[[frames.offsets]]``: eccentric connections. The ends of a member group sit at ``offset``
 (global axes) from their nodes, joined to them by rigid arms (stiff massless beams, so
 rigid at any rotation up to a compliance 1e-6 of the member's); a release at such an end
-acts at the node, between the arm and the node::
+acts at the node, between the arm and the node. Why stiff beams and not an exact tie: the
+member's end and the node are two mesh vertices, and a UFL form cannot couple two vertices
+(DOLFINx 0.5.2 has no multipoint constraints); a stiff geometrically exact beam is rigid at
+any rotation, needs no other code, and works in every analysis::
 
     [[frames.offsets]]
     group = "beams"
@@ -39,6 +42,8 @@ JOINT_TYPES = ("rigid", "pinned")
 ENDS = ("start", "end")
 #: a rigid arm's stiffnesses over its member's largest (its compliance is 1e-6 of theirs)
 ARM_STIFFNESS = 1e6
+#: the longest offset, in lengths of its member (a longer rigid arm is surely a mistake)
+MAX_OFFSET = 10.0
 
 
 def _released(t):
@@ -109,6 +114,13 @@ def read_offsets(frame, sub_tables, groups, mesh):
         for k in (int(x) for x in members):
             if mesh.curves and mesh.curves[k] is not None:
                 t.fail("group", f"member {k + 1} of {group!r} is curved: offsets need lines")
+            length = np.linalg.norm(np.diff(mesh.points[mesh.members[k]], axis=0))
+            if np.linalg.norm(offset) > MAX_OFFSET * length:
+                t.fail(
+                    "offset",
+                    f"{list(offset)} is longer than {MAX_OFFSET:g} times member {k + 1} "
+                    f"({length:.3g} long)",
+                )
             for e in (0, 1) if end == "both" else (ENDS.index(end),):
                 if (k, e) in out:
                     t.fail("group", f"member {k + 1} of {group!r} has two offsets at its {ENDS[e]}")

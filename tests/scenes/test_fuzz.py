@@ -640,6 +640,7 @@ FRAME_BASE = {
             "supports": [{"group": "feet", "fix": "all"}],
             "loads": [{"group": "knees", "force": [1e3, 0, 0], "moment": [0, 0, 1.0]}],
             "probes": [{"group": "knees", "name": "k"}],
+            "offsets": [{"group": "beam", "end": "both", "offset": [0, 0.1, 0.2]}],
             "joints": [
                 {
                     "group": "knees",
@@ -655,7 +656,7 @@ FRAME_BASE = {
 
 
 def test_fuzzed_frame_keys_are_refused_by_name_or_pass_finite(folder):
-    """Every key of a [[frames]] scene (members, supports, loads, probes, joints) set to
+    """Every key of a [[frames]] scene (members, supports, loads, probes, offsets, joints) set to
     hostile values or removed: refused naming the file and the key, or valid and finite."""
     from beamfx.geometry.line_mesh import write_line_mesh
 
