@@ -7,10 +7,10 @@ directions that move the hinge unknowns (:mod:`beamfx.analyses.releases`), while
 rigid-body motions of a free structure (which :func:`~beamfx.analyses.checks.check_supported`
 answers for) leave them at zero.
 
-The check: K with unit section stiffnesses (:func:`unit_stiffness`; Dirichlet rows
-identity), Jacobi-scaled to S = D^{-1/2} K D^{-1/2} (unit
+The check: K with unit section stiffnesses (:func:`unit_stiffness`) and without its
+Dirichlet rows and columns, Jacobi-scaled to S = D^{-1/2} K D^{-1/2} (unit
 diagonal, so the threshold is scale-free), gathered on rank 0 and decomposed densely
-(``numpy.linalg.eigh``); its null space N = eigenvectors with λ < 1e-10 (round-off of a
+(``scipy.linalg.eigh``, the eigenpairs below the threshold only); its null space N = eigenvectors with λ < 1e-10 (round-off of a
 unit-diagonal matrix is ~1e-15, the smallest eigenvalue of a sound slender frame ~1e-8 or
 more). The number of mechanisms is the rank of N restricted to the hinge rows, and the joints
 named are the releases whose rows carry them. Dense: kept to models of at most
@@ -44,10 +44,13 @@ def _gather_dense(A, comm):
 
 def null_space(K, tol=NULL_TOL):
     """Orthonormal basis (columns) of the null space of the symmetric ``K``, Jacobi-scaled:
-    returned in the unscaled unknowns (not orthonormal there)."""
+    returned in the unscaled unknowns (not orthonormal there). Only the eigenpairs below
+    ``tol`` are computed (LAPACK's MRRR on a value range)."""
+    from scipy.linalg import eigh
+
     d = np.sqrt(np.maximum(np.abs(np.diag(K)), 1e-300))
-    lam, V = np.linalg.eigh(K / np.outer(d, d))
-    return V[:, lam < tol] / d[:, None]
+    _, V = eigh(K / np.outer(d, d), subset_by_value=(-np.inf, tol), driver="evr")
+    return V / d[:, None]
 
 
 def mechanisms(N, rows):
@@ -63,6 +66,27 @@ def mechanisms(N, rows):
     count = int(np.sum(sv > 1e-8))
     moving = [k for k, r in rows.items() if np.abs(N[r]).max() > 1e-8 * scale]
     return count, moving
+
+
+def _constrained(W, bcs):
+    """Global indices of the owned Dirichlet dofs of ``bcs`` (their rows are identity),
+    gathered on rank 0 (None elsewhere)."""
+    imap = W.dofmap.index_map
+    rows = [np.empty(0, np.int64)]
+    for bc in bcs:
+        dofs, owned = bc.dof_indices()
+        rows.append(np.asarray(imap.local_to_global(dofs[:owned].astype(np.int32)), np.int64))
+    parts = W.mesh.comm.gather(np.concatenate(rows), root=0)
+    return None if parts is None else np.unique(np.concatenate(parts))
+
+
+def _free_part(K, fixed, rows):
+    """K without the Dirichlet rows and columns (decoupled identity), and the hinge rows
+    {release: indices} renumbered into it."""
+    keep = np.setdiff1d(np.arange(len(K)), fixed)
+    at = np.full(len(K), -1)
+    at[keep] = np.arange(len(keep))
+    return K[np.ix_(keep, keep)], {r: at[g][at[g] >= 0] for r, g in rows.items()}
 
 
 def _global_rows(W, local):
@@ -126,7 +150,11 @@ def check_mechanisms(model):
     K = _gather_dense(A, comm)
     A.destroy()
     rows = _global_rows(model.W, hinge_dofs(model.W, model.hinges))
-    found = mechanisms(null_space(K), rows) if comm.rank == 0 else None
+    fixed = _constrained(model.W, model.bcs)
+    found = None
+    if comm.rank == 0:
+        K, rows = _free_part(K, fixed, rows)
+        found = mechanisms(null_space(K), {r: g for r, g in rows.items() if len(g)})
     count, moving = comm.bcast(found, root=0)
     if count:
         releases = model.spec.releases
