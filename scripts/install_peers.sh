@@ -6,7 +6,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${PEERS_VENV:-.venv-peers}
-PKGS=(exudyn pyelastica numpy matplotlib "openseespy==3.8.0.0")
+# openseespy 3.8 needs Python >= 3.12 (its openseespylinux wheel); 3.7.1.2 is the newest for Debian 12's 3.11
+# Pinned as resolved on 2026-11-23 (Debian 12, Python 3.11)
+PKGS=("exudyn==1.13.6" "pyelastica==1.0.0" "numpy==2.4.6" "matplotlib==3.11.2"
+  "openseespy==3.7.1.2" "pybmodes==1.19.1")
 
 # CalculiX (Debian `calculix-ccx`, binary `ccx`): checked before the fast path below
 if ! command -v ccx >/dev/null 2>&1; then
@@ -21,13 +24,14 @@ fi
 if [ ! -x "$VENV/bin/python" ]; then
   /usr/bin/python3 -m venv "$VENV"
 fi
-if "$VENV/bin/python" -c "import exudyn, elastica, numpy, matplotlib, openseespy.opensees" 2>/dev/null; then
+if "$VENV/bin/python" -c "import exudyn, elastica, numpy, matplotlib, openseespy.opensees, pybmodes" 2>/dev/null; then
   exit 0
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 "$VENV/bin/python" -m pip install --quiet "${PKGS[@]}"
 "$VENV/bin/python" - <<'PY'
-import exudyn, elastica, numpy, openseespy.opensees
-print("peers: exudyn", exudyn.__version__, "| pyelastica", getattr(elastica, "__version__", "?"),
-      "| openseespy", getattr(openseespy.opensees, "version", lambda: "?")(), "| numpy", numpy.__version__)
+from importlib.metadata import version
+import openseespy.opensees
+print("peers:", " | ".join(f"{p} {version(p)}" for p in
+      ("exudyn", "pyelastica", "openseespy", "pybmodes", "numpy")))
 PY
