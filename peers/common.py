@@ -9,6 +9,7 @@ formula). The merge step recomputes every error with the beamfx metric anyway.
 
 import json
 import math
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -39,7 +40,32 @@ def warm(run):
     return out, time.perf_counter() - t1, cold
 
 
+def import_seconds(*modules):
+    """Wall time of a fresh interpreter that only imports ``modules`` (the second of two
+    runs, so the disk cache is warm): the one-off start of a user's script."""
+    code = "; ".join(f"import {m}" for m in modules) or "pass"
+    for _ in range(2):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
+        seconds = time.perf_counter() - t0
+    return seconds
+
+
+def whole_times(wall_s, extra):
+    """The whole-run times of a record: ``whole_s`` = model build (``setup_s``) + the warm
+    solve, ``first_s`` = build + the first solve (first calls, numba JIT); None where the
+    solve failed."""
+    setup = extra.get("setup_s") or 0.0
+    cold = extra.get("cold_s")
+    return {
+        "whole_s": None if wall_s is None else setup + wall_s,
+        "first_s": None if wall_s is None or cold is None else setup + cold,
+    }
+
+
 def record(problem_id, problem, code, element, setting, unknowns, wall_s, values, **extra):
+    """One peer record; ``wall_s`` is the warm solve (the second of two identical solves),
+    ``extra`` may hold ``setup_s`` (model build) and ``cold_s`` (the first solve)."""
     err = error(values, problem) if values is not None else None
     r = {
         "problem": problem_id,
@@ -48,6 +74,7 @@ def record(problem_id, problem, code, element, setting, unknowns, wall_s, values
         "setting": setting,
         "unknowns": unknowns,
         "wall_s": wall_s,
+        **whole_times(wall_s, extra),
         "error": err,
         "values": values,
     }
@@ -61,10 +88,13 @@ def record(problem_id, problem, code, element, setting, unknowns, wall_s, values
     return r
 
 
-def write(out_dir, code, records, meta=None):
+def write(out_dir, code, records, meta=None, imports=()):
+    """Write DIR/<code>.json; ``meta["import_s"]`` = :func:`import_seconds` of ``imports``
+    (0 for a code run as its own program, e.g. ccx: its process time is its whole run)."""
+    meta = dict(meta or {}, import_s=import_seconds(*imports) if imports else 0.0)
     path = Path(out_dir) / f"{code}.json"
     path.write_text(
-        json.dumps({"code": code, "meta": meta or {}, "records": records}, indent=1, default=float)
+        json.dumps({"code": code, "meta": meta, "records": records}, indent=1, default=float)
     )
     print(f"wrote {path} ({len(records)} records)")
 

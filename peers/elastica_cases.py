@@ -132,7 +132,8 @@ def main():
         ("spin_up", "not run: no prescribed-rotation (hub) boundary condition built in"),
     ):
         recs.append(common.record(pid, P[pid], CODE, ELEMENT, "—", None, None, None, note=why))
-    common.write(out_dir, "pyelastica", recs, {"version": getattr(ea, "__version__", "1.0.0")})
+    meta = {"version": getattr(ea, "__version__", "1.0.0")}
+    common.write(out_dir, "pyelastica", recs, meta, imports=("numpy", "elastica"))
 
 
 if __name__ == "__main__":

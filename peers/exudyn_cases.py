@@ -366,7 +366,13 @@ def main():
         P["spin_up"],
         [(8, 0.01), (16, 0.01), (32, 0.01), (32, 0.005), (32, 0.0025), (32, 0.00125)],
     )
-    common.write(out_dir, "exudyn", recs, {"version": exu.__version__})
+    common.write(
+        out_dir,
+        "exudyn",
+        recs,
+        {"version": exu.__version__},
+        imports=("numpy", "exudyn", "exudyn.itemInterface"),
+    )
 
 
 if __name__ == "__main__":
