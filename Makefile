@@ -37,18 +37,22 @@ bench-solid-scaling: install
 	$(MPIRUN) $(PY) -m beamfx.bench.solid_scaling run docs/validation
 	$(PY) -m beamfx.bench.solid_scaling report docs/validation
 
-# beamfx beside Exudyn and PyElastica (own venv .venv-peers, not part of `make test`)
+# beamfx beside Exudyn, PyElastica, CalculiX, OpenSeesPy and pyBModes (peer venv PEERS_VENV,
+# default .venv-peers; not part of `make test`); report in docs/validation/peers*.md
 PEERS := build/peers
+PEERS_VENV ?= .venv-peers
+PEERS_PY := $(PEERS_VENV)/bin/python
 bench-peers: install
-	bash scripts/install_peers.sh
+	PEERS_VENV=$(PEERS_VENV) bash scripts/install_peers.sh
 	$(PY) -m beamfx.bench.peers export $(PEERS)
-	.venv-peers/bin/python peers/exudyn_cases.py $(PEERS)
-	.venv-peers/bin/python peers/elastica_cases.py $(PEERS)
-	.venv-peers/bin/python peers/calculix_cases.py $(PEERS)
+	$(PEERS_PY) peers/exudyn_cases.py $(PEERS)
+	$(PEERS_PY) peers/elastica_cases.py $(PEERS)
+	$(PEERS_PY) peers/calculix_cases.py $(PEERS)
 	$(PY) -m beamfx.bench.peers $(PEERS) docs/validation
 	$(PY) -m beamfx.bench.frame_peers export $(PEERS)
-	.venv-peers/bin/python peers/opensees_frame.py $(PEERS)
-	$(PY) -m beamfx.bench.frame_peers $(PEERS)
+	$(PEERS_PY) peers/opensees_frame.py $(PEERS)
+	$(PY) -m beamfx.bench.frame_peers $(PEERS) docs/validation
+	$(PEERS_PY) peers/pybmodes_blade.py $(PEERS)
 
 lint: install
 	$(VENV)/bin/ruff check .

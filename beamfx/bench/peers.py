@@ -2,12 +2,14 @@
 
 ``make bench-peers`` runs three steps (see ``peers/README.md``)::
 
-    python -m beamfx.bench.peers export DIR    # problems.json: the data the peer scripts read
-    .venv-peers/bin/python peers/run.py DIR    # Exudyn, PyElastica, CalculiX: DIR/<code>.json
-    python -m beamfx.bench.peers DIR REPORT    # beamfx on the same problems, merge, report
+    python -m beamfx.bench.peers export DIR         # problems.json: what the peer scripts read
+    .venv-peers/bin/python peers/<code>_cases.py DIR  # Exudyn, PyElastica, CalculiX: <code>.json
+    python -m beamfx.bench.peers DIR REPORT         # beamfx on the same problems, merge, report
 
-A peer record is ``{problem, code, element, setting, unknowns, wall_s, error, values}``
-(``wall_s`` warm: the second of two identical solves). The merge recomputes every error
+A record is ``{problem, code, element, setting, unknowns, whole_s, first_s, wall_s,
+process_s, error, values}``: the times are defined in :mod:`.peers_report` (``whole_s`` the
+whole run in a warm process, on which the verdict stands; ``wall_s`` the solve alone). The
+merge recomputes every error
 from ``values`` with the metric and reference of the beamfx case (:func:`.run._error`),
 so beamfx and the peers are scored by the same numbers; where the reference is withheld
 (spin-up, 45° bend) it is the finest beamfx setting, which is then not scored itself.
@@ -20,6 +22,8 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+
+from .peers_report import NOTES, markdown, plot
 
 TARGET = 1e-6  # issue 7: the error at which beamfx must be ahead
 
@@ -57,59 +61,6 @@ ELEMENTS = {
     "planar": "Simo-Reissner, planar (angle field)",
     "condensed": "Simo-Reissner, condensed (rotation vector field)",
     "planar condensed": "Simo-Reissner, planar condensed (angle field)",
-}
-
-# why the numbers look as they do (facts of the methods, not of one run)
-NOTES = {
-    "rollup_half": "Exudyn's two-node BeamGeometricallyExact interpolates on SE(3): a constant-"
-    "curvature arc is in its interpolation space, so pure bending is exact (to Newton "
-    "tolerance) with any number of elements and Exudyn reaches round-off in milliseconds. "
-    "beamfx's scene builder picks its planar statically condensed model here (a plane "
-    "cantilever under an end moment): the angle θ(s) is the only unknown, the exact θ = M s/EI "
-    "lies in every P_k, and the centre line of a θ linear in a cell is integrated in closed "
-    "form, so one P1 element (2 unknowns) is exact to round-off at any number of turns; the "
-    "P3/P4 rows are the meshes the quaternion model needed (4 x P3: 5.6e-7 at 91 unknowns). "
-    "PyElastica applies the end moment as a couple on the last element, which "
-    "stays straight, so its tip lags by about one element length (first order in h).",
-    "rollup_full": "As for the half circle: exact for Exudyn's SE(3) element from 4 elements "
-    "(2 elements fail: each would turn by π, where the SE(3) logarithm is singular); exact for "
-    "beamfx's planar condensed model from one element (no 2π limit on the angle). "
-    "PyElastica's straight last element lands on the exact tip for the full circle by "
-    "symmetry (the tip is the root), so its small error there is a coincidence of this load.",
-    "sm23": "The section is 4:1 and the moments are fixed in space, so the curvature varies "
-    "along the beam and no element is exact: Exudyn's two-node element converges at second "
-    "order (error /4 per doubling), beamfx's P4 elements at high order.",
-    "sm28": "Scored against the Euler-Bernoulli theory of the paper; that needs a shear-rigid "
-    "beam without bending rotary inertia, which beamfx has as a model option. Exudyn's "
-    "geometrically exact element locks under a shear penalty, so it is compared on "
-    "sm28_timoshenko instead, where both codes solve the same shear-flexible beam.",
-    "sm28_timoshenko": "The same free-free beam with its shear stiffness and full rotary "
-    "inertia; values are frequencies divided by the Euler-Bernoulli theory, the reference is "
-    "the finest beamfx setting (16 x P4). Exudyn's eigenvalues are dense "
-    "(ComputeODE2Eigenvalues), beamfx's shift-invert SLEPc, one solve per frequency.",
-    "spin_up": "Reference values are withheld (VM258): the reference is the last beamfx "
-    'setting (8 x P3, scheme "extrapolated" at dt = 0.00625: generalized-α with ρ∞ = 0.8 at '
-    "dt and dt/2, Richardson-combined; its error in time is about 1e-8, in space that of "
-    "8 x P3). The plain beamfx rows and Exudyn use generalized-α with ρ∞ = 0.9, second "
-    "order in time, so dt sets the error; the extrapolated rows (three Newton solves per "
-    "step: 2.2 to 2.8 times the iterations of the plain run at the same dt) are third to fourth "
-    "order in time, and at dt = 0.025 their error in time (2e-6) is below the error in space "
-    "of 4 x P2 (1e-4), so the mesh sets it: 8 x P2 costs little more per iteration. At "
-    "equal dt beamfx's planar model has fewer unknowns (4 quadratic elements, 27) than "
-    "Exudyn's 32 two-node elements (99). The Exudyn hub angle is a Python offset user "
-    "function, called at every Newton iteration. Exudyn's Newton absolute tolerance had to "
-    "be raised to 1e-6 N: at its default, Newton stalls at round-off (EA = 2.8e7) and the "
-    "adaptive step collapses (95 s instead of 0.6 s). With the plain scheme beamfx needs "
-    "dt = 0.00625 (4 x P2, 4882 Newton iterations) for Exudyn's best error (32 elements at "
-    "dt = 0.00125), at a wall time within a few per cent of Exudyn's: its cost per step "
-    "(about 0.4 ms, 27 unknowns) is several times Exudyn's (0.2 ms per step at 99 unknowns), "
-    "the assembly through DOLFINx/PETSc per step dominating at this size. The extrapolated "
-    "rows at dt = 0.025 take about 5100 iterations, and their error is that of the mesh "
-    "(4 x P2: 1e-4, 8 x P2: 7e-6). Near 1e-3 extrapolation does not pay: its coarsest "
-    "usable dt is 0.025 (at 0.05 the base with ρ∞ = 0.8 needs cut-backs; with ρ∞ = 0.5 "
-    "the mean stretch is off by 1.3 %), which costs more than the plain run at dt = 0.0125.",
-    "bend45": "Reference withheld: the finest beamfx setting (32 x P4). Exudyn's two-node "
-    "elements on the arc (nodes on the circle, chord lengths) converge at second order.",
 }
 
 
@@ -202,9 +153,13 @@ def run_beamfx(out_dir, log=print):
                     "code": "beamfx",
                     "element": element,
                     "setting": setting,
+                    "case_setting": [row["elements"], row["degree"]]
+                    + [row[k] for k in ("dt", "scheme") if k in row],
                     "unknowns": row["unknowns"],
+                    "whole_s": row.get("wall_s_whole"),
+                    "first_s": row["wall_s_cold"],
                     "wall_s": row["wall_s_warm"],
-                    "setup_s": row["wall_s_cold"] - row["wall_s_warm"],
+                    "process_s": row.get("wall_s_process"),
                     "error": row["error"],
                     "values": row["values"],
                     "is_reference": finest and i == len(result["rows"]) - 1,
@@ -240,14 +195,53 @@ def line(r):
     return f"{r['code']} ({r['element']})" if r.get("element") else r["code"]
 
 
-def time_to(records, target):
-    """Smallest warm wall time among ``records`` whose error is <= ``target`` (None: never)."""
-    ok = [r["wall_s"] for r in records if r.get("error") is not None and r["error"] <= target]
-    return min(ok) if ok else None
+def at_target(records, target, key="whole_s"):
+    """The record of ``records`` with error <= ``target`` and the least ``key`` time (None:
+    none reaches it). ``key``: ``whole_s`` (the whole run) or ``wall_s`` (the solve alone)."""
+    ok = [
+        r
+        for r in records
+        if r.get("error") is not None and r["error"] <= target and r.get(key) is not None
+    ]
+    return min(ok, key=lambda r: r[key]) if ok else None
+
+
+def time_to(records, target, key="whole_s"):
+    """The least ``key`` time among ``records`` whose error is <= ``target`` (None: never)."""
+    r = at_target(records, target, key)
+    return None if r is None else r[key]
+
+
+def _line_summary(group, target):
+    """One code's figures on a problem: times to the target, best error, note."""
+    scored = [r for r in group if r.get("error") is not None]
+    best = min(scored, key=lambda r: r["error"]) if scored else None
+    fastest = at_target(group, target)
+    return {
+        "code": group[0]["code"],
+        "time_to_target": time_to(group, target),
+        "solve_to_target": time_to(group, target, "wall_s"),
+        "process_at_target": None if fastest is None else fastest.get("process_s"),
+        "setting_at_target": None if fastest is None else fastest["setting"],
+        "best_error": best["error"] if best else None,
+        "note": next((r["note"] for r in group if r.get("note")), ""),
+    }
+
+
+def _ahead(lines, key):
+    """(beamfx's least ``key`` time to the target, whether every peer that reaches the target
+    takes longer, the fastest such peer (name, time) or None)."""
+    fx = [v[key] for v in lines.values() if v["code"] == "beamfx" and v[key] is not None]
+    t_fx = min(fx, default=None)
+    others = [(v[key], n) for n, v in lines.items() if v["code"] != "beamfx" and v[key]]
+    fastest = min(others, default=None)
+    ahead = t_fx is not None and (fastest is None or fastest[0] > t_fx)
+    return t_fx, ahead, None if fastest is None else (fastest[1], fastest[0])
 
 
 def summary(records, problem):
-    """Per problem: the target error and, per line, the time to reach it and the best error."""
+    """Per problem: the target error and, per line, the times to reach it (whole run, solve
+    only, process) and the best error; the verdict on whole runs and on the solve alone."""
     rows = [r for r in records if r["problem"] == problem]
     peers = [r for r in rows if r["code"] != "beamfx" and r.get("error") is not None]
     best_peer = min((r["error"] for r in peers), default=None)
@@ -255,138 +249,37 @@ def summary(records, problem):
     groups = {}
     for r in rows:
         groups.setdefault(line(r), []).append(r)
-    out = {"target": target, "lines": {}}
-    for name, group in groups.items():
-        scored = [r for r in group if r.get("error") is not None]
-        best = min(scored, key=lambda r: r["error"]) if scored else None
-        out["lines"][name] = {
-            "code": group[0]["code"],
-            "time_to_target": time_to(group, target),
-            "best_error": best["error"] if best else None,
-            "best_wall_s": best["wall_s"] if best else None,
-            "note": next((r["note"] for r in group if r.get("note")), ""),
-        }
-    fx = [v for v in out["lines"].values() if v["code"] == "beamfx"]
-    t_fx = min((v["time_to_target"] for v in fx if v["time_to_target"] is not None), default=None)
-    out["beamfx_time"] = t_fx
-    out["beamfx_ahead"] = t_fx is not None and all(
-        v["time_to_target"] is None or v["time_to_target"] > t_fx
-        for v in out["lines"].values()
-        if v["code"] != "beamfx"
-    )
+    out = {"target": target, "lines": {n: _line_summary(g, target) for n, g in groups.items()}}
+    t_fx, ahead, fastest = _ahead(out["lines"], "time_to_target")
+    out |= {"beamfx_time": t_fx, "beamfx_ahead": ahead, "fastest_peer": fastest}
+    t_solve, ahead_solve, _ = _ahead(out["lines"], "solve_to_target")
+    out |= {"beamfx_solve_time": t_solve, "beamfx_ahead_solve": ahead_solve}
+    fx = at_target([r for r in rows if r["code"] == "beamfx"], target)
+    out["beamfx_at_target"] = fx
     return out
 
 
-def _fmt(x, f="{:.2e}"):
-    return "—" if x is None else f.format(x)
+PEER_FILES = ("calculix.json", "exudyn.json", "pyelastica.json")  # what peers/*_cases.py write
 
 
-def plot(records, problem, title, path, target=None):
-    """Error against wall time of every code on ``problem`` (log-log), saved to ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    groups = {}
-    for r in records:
-        if r["problem"] == problem and r.get("error") and r.get("wall_s"):
-            groups.setdefault(line(r), []).append(r)
-    for name, group in sorted(groups.items(), key=lambda g: g[0] != "beamfx"):
-        group.sort(key=lambda r: r["wall_s"])
-        style = "o-" if group[0]["code"] == "beamfx" else "s--"
-        ax.loglog([r["wall_s"] for r in group], [r["error"] for r in group], style, label=name)
-    if target:
-        ax.axhline(target, color="grey", lw=0.8, ls=":", label=f"target {target:.1e}")
-    ax.set_xlabel("warm wall time [s]")
-    ax.set_ylabel("error")
-    ax.set_title(title, fontsize=10)
-    ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def markdown(records, problems, notes=None):
-    """The report: a summary table (time to the target per code), then per problem the
-    full table and its plot."""
-    lines = [
-        "# beamfx beside its peers",
-        "",
-        (
-            "Generated by `make bench-peers`: the peer codes run in their own environment "
-            "(`.venv-peers`; CalculiX from Debian), then beamfx, on the same machine in one run. "
-            "Errors use the metric and reference of the beamfx case (the reference of withheld "
-            "cases is the finest beamfx setting, marked *reference* and not scored). Wall times "
-            "are warm: the second of two "
-            "identical solves, so one-off costs (imports, JIT compilation, numba) are left out and "
-            "shown separately where large. Target = the larger of 1e-6 and the best error any peer "
-            "reaches; beamfx is *ahead* when it reaches the target in less time than every peer "
-            "that reaches it."
-        ),
-        "",
-        "| problem | target | beamfx s | " + "peers: s to target (best error) | beamfx ahead |",
-        "|---|---|---|---|---|",
-    ]
-    sections = []
-    for pid, meta in problems.items():
-        s = summary(records, pid)
-        peer_cells = []
-        for name, v in s["lines"].items():
-            if v["code"] == "beamfx":
-                continue
-            if v["best_error"] is None:
-                peer_cells.append(f"{name}: {v['note'] or 'not run'}")
-            else:
-                peer_cells.append(
-                    f"{name}: {_fmt(v['time_to_target'], '{:.3g}')} ({v['best_error']:.1e})"
-                )
-        lines.append(
-            f"| {pid} | {s['target']:.1e} | {_fmt(s['beamfx_time'], '{:.3g}')} | "
-            + "<br>".join(peer_cells or ["no peer"])
-            + f" | {'yes' if s['beamfx_ahead'] else '**no**'} |"
-        )
-        sections += [
-            "",
-            f"## {pid}: {meta.get('title', '')}",
-            "",
-            f"beamfx case `{meta.get('beamfx_case', '')}`; target error {s['target']:.1e}.",
-            "",
-            f"![error against warm wall time, {pid}](peers_{pid}.png)",
-            "",
-            "| code (element) | setting | unknowns | warm s | error |",
-            "|---|---|---|---|---|",
-        ]
-        for r in sorted(
-            (r for r in records if r["problem"] == pid),
-            key=lambda r: (
-                r["code"] != "beamfx",
-                line(r),
-                r.get("unknowns") or 0,
-                r["wall_s"] or 0,
-            ),
-        ):
-            err = "reference" if r.get("is_reference") else _fmt(r.get("error"))
-            if r.get("error") is None and not r.get("is_reference") and r.get("note"):
-                err = r["note"]
-            lines_wall = _fmt(r.get("wall_s"), "{:.3g}")
-            sections.append(
-                f"| {line(r)} | {r['setting']} | {r.get('unknowns') or '—'} | {lines_wall} | {err} |"
-            )
-        if notes and pid in notes:
-            sections += ["", notes[pid]]
-    return "\n".join(lines + sections) + "\n"
+def _peer_files(peer_dir):
+    return [Path(peer_dir) / f for f in PEER_FILES if (Path(peer_dir) / f).exists()]
 
 
 def load_peer_records(peer_dir):
-    """The records of every peer code's JSON file in ``peer_dir``."""
+    """The records of every peer code's JSON file in ``peer_dir``, with their process time
+    (the file's ``meta.import_s`` + the record's first run); a file written before the
+    whole-run times has its whole run made up as model build + warm solve."""
     records = []
-    for f in sorted(Path(peer_dir).glob("*.json")):
-        if f.name in ("problems.json", "beamfx.json"):
-            continue
-        records += json.loads(f.read_text())["records"]
+    for f in _peer_files(peer_dir):
+        data = json.loads(f.read_text())
+        import_s = data.get("meta", {}).get("import_s")
+        for r in data["records"]:
+            if "whole_s" not in r and r.get("wall_s") is not None:
+                r["whole_s"] = r["wall_s"] + (r.get("setup_s") or 0.0)
+            if import_s is not None and r.get("first_s") is not None:
+                r["process_s"] = import_s + r["first_s"]
+            records.append(r)
     return records
 
 
@@ -394,12 +287,27 @@ def load_peer_notes(peer_dir):
     """Per problem, the notes the peer scripts leave in their meta data (``"notes": {problem:
     text}``, e.g. what CalculiX could not do and why), joined in file order."""
     out = {}
-    for f in sorted(Path(peer_dir).glob("*.json")):
-        if f.name in ("problems.json", "beamfx.json"):
-            continue
+    for f in _peer_files(peer_dir):
         for pid, text in json.loads(f.read_text()).get("meta", {}).get("notes", {}).items():
             out[pid] = f"{out[pid]} {text}" if pid in out else text
     return out
+
+
+def measure_processes(records, problems, log=print):
+    """``beamfx run`` timed from outside (:func:`.process.process_seconds`) for the beamfx
+    setting of each problem that reaches the target in the least whole-run time."""
+    import tempfile
+
+    from .process import process_seconds
+
+    for pid, meta in problems.items():
+        fx = summary(records, pid)["beamfx_at_target"]
+        if fx is None or fx.get("process_s") is not None or not fx.get("case_setting"):
+            continue
+        with tempfile.TemporaryDirectory(prefix="beamfx-peers-") as folder:
+            fx["process_s"] = process_seconds(meta["beamfx_case"], fx["case_setting"], folder)
+        if log:
+            log(f"beamfx {pid} {fx['setting']}: beamfx run process {fx['process_s']:.2f} s")
 
 
 def merge(peer_dir, report_dir, run=True, log=print):
@@ -419,6 +327,8 @@ def merge(peer_dir, report_dir, run=True, log=print):
     notes = NOTES | (json.loads(notes_file.read_text()) if notes_file.exists() else {})
     for pid, text in load_peer_notes(peer_dir).items():
         notes[pid] = f"{notes[pid]} {text}" if pid in notes else text
+    if run:
+        measure_processes(records, problems, log)
     report.mkdir(parents=True, exist_ok=True)
     for pid, meta in problems.items():
         plot(

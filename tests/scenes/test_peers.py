@@ -6,12 +6,14 @@ from beamfx.bench import peers
 
 
 def _rec(code, setting, wall, err, problem="p", element="", **kw):
+    """A record whose whole run is its solve unless ``whole_s`` is given."""
     return {
         "problem": problem,
         "code": code,
         "element": element,
         "setting": setting,
         "unknowns": 10,
+        "whole_s": wall,
         "wall_s": wall,
         "error": err,
         "values": None,
@@ -52,6 +54,35 @@ def test_summary_target_and_verdict():
     recs.append(_rec("Exudyn", "fast", 0.01, 1e-6, element="GE"))
     s = peers.summary(recs, "p")
     assert s["target"] == 1e-6 and not s["beamfx_ahead"]
+
+
+def test_verdict_on_whole_runs_with_the_solve_only_verdict_beside_it():
+    recs = [
+        _rec("beamfx", "4 x P4", 0.01, 1e-7, whole_s=0.5),
+        _rec("Exudyn", "8", 0.1, 1e-6, element="GE", whole_s=0.2),
+    ]
+    s = peers.summary(recs, "p")
+    assert s["beamfx_time"] == 0.5 and s["beamfx_solve_time"] == 0.01
+    assert not s["beamfx_ahead"] and s["beamfx_ahead_solve"]
+    assert s["fastest_peer"] == ("Exudyn (GE)", 0.2)
+    md = peers.markdown(recs, {"p": {"title": "fake", "beamfx_case": "c"}})
+    assert "| **no** | yes |" in md
+    assert "beamfx 0.5 s (4 x P4) against Exudyn (GE) 0.2 s: 2.5 x the time" in md
+
+
+def test_peer_files_give_whole_and_process_times(tmp_path):
+    """A peer file's import time + a record's first run = its process time; an older file's
+    whole run is its model build + warm solve."""
+    recs = [
+        _rec("Exudyn", "8", 0.1, 1e-3, first_s=0.4),
+        {"problem": "p", "code": "Exudyn", "setting": "4", "wall_s": 0.1, "setup_s": 0.05},
+    ]
+    meta = {"import_s": 1.5}
+    (tmp_path / "exudyn.json").write_text(json.dumps({"meta": meta, "records": recs}))
+    (tmp_path / "frame_compare.json").write_text("[]")  # not a peer file of this report
+    got = peers.load_peer_records(tmp_path)
+    assert len(got) == 2 and abs(got[0]["process_s"] - 1.9) < 1e-12
+    assert abs(got[1]["whole_s"] - 0.15) < 1e-12 and "process_s" not in got[1]
 
 
 def test_markdown_and_plot(tmp_path):

@@ -1,0 +1,247 @@
+"""The report of :mod:`beamfx.bench.peers`: ``peers.md`` (summary table, then per problem the
+full table, its plot and why the numbers look as they do) and the error-against-time plots.
+
+Times (seconds; each record's fields):
+
+* ``whole_s``: the whole run as a user waits for it in a warm process. beamfx: the second
+  :func:`~beamfx.runner.run_scene` of the setting's scene (model, solve, probes, output as the
+  scene asks); peers: model build + solve, the second of two identical runs (no files).
+* ``first_s``: the first such run in the process (JIT compilation or its cache, numba, first
+  calls).
+* ``process_s``: a fresh process. beamfx: ``beamfx run`` of the setting timed from outside
+  (:mod:`.process`), measured for the setting that reaches the target; peers: a fresh
+  interpreter that imports the code (``meta.import_s``) + ``first_s``; CalculiX: its first
+  ``ccx`` run (a program of its own).
+* ``wall_s``: the solve alone, warm (beamfx: assembly and linear solves; Exudyn: its
+  solver call on the assembled system; PyElastica: the whole relaxation; ccx: the process).
+
+The verdict uses whole runs; the solve-only verdict stands beside it.
+"""
+
+# why the numbers look as they do (facts of the methods, not of one run)
+NOTES = {
+    "rollup_half": "Exudyn's two-node BeamGeometricallyExact interpolates on SE(3): a constant-"
+    "curvature arc is in its interpolation space, so pure bending is exact (to Newton "
+    "tolerance) with any number of elements and Exudyn reaches round-off in milliseconds. "
+    "beamfx's scene builder picks its planar statically condensed model here (a plane "
+    "cantilever under an end moment): the angle θ(s) is the only unknown, the exact θ = M s/EI "
+    "lies in every P_k, and the centre line of a θ linear in a cell is integrated in closed "
+    "form, so one P1 element (2 unknowns) is exact to round-off at any number of turns; the "
+    "P3/P4 rows are the meshes the quaternion model needed (4 x P3: 5.6e-7 at 91 unknowns). "
+    "PyElastica applies the end moment as a couple on the last element, which "
+    "stays straight, so its tip lags by about one element length (first order in h).",
+    "rollup_full": "As for the half circle: exact for Exudyn's SE(3) element from 4 elements "
+    "(2 elements fail: each would turn by π, where the SE(3) logarithm is singular); exact for "
+    "beamfx's planar condensed model from one element (no 2π limit on the angle). "
+    "PyElastica's straight last element lands on the exact tip for the full circle by "
+    "symmetry (the tip is the root), so its small error there is a coincidence of this load.",
+    "sm23": "The section is 4:1 and the moments are fixed in space, so the curvature varies "
+    "along the beam and no element is exact: Exudyn's two-node element converges at second "
+    "order (error /4 per doubling), beamfx's P4 elements at high order.",
+    "sm28": "Scored against the Euler-Bernoulli theory of the paper; that needs a shear-rigid "
+    "beam without bending rotary inertia, which beamfx has as a model option. Exudyn's "
+    "geometrically exact element locks under a shear penalty, so it is compared on "
+    "sm28_timoshenko instead, where both codes solve the same shear-flexible beam.",
+    "sm28_timoshenko": "The same free-free beam with its shear stiffness and full rotary "
+    "inertia; values are frequencies divided by the Euler-Bernoulli theory, the reference is "
+    "the finest beamfx setting (16 x P4). Exudyn's eigenvalues are dense "
+    "(ComputeODE2Eigenvalues), beamfx's shift-invert SLEPc, one solve per frequency.",
+    "spin_up": "Reference values are withheld (VM258): the reference is the last beamfx "
+    'setting (8 x P3, scheme "extrapolated" at dt = 0.00625: generalized-α with ρ∞ = 0.8 at '
+    "dt and dt/2, Richardson-combined; its error in time is about 1e-8, in space that of "
+    "8 x P3). The plain beamfx rows and Exudyn use generalized-α with ρ∞ = 0.9, second "
+    "order in time, so dt sets the error; the extrapolated rows (three Newton solves per "
+    "step: 2.2 to 2.8 times the iterations of the plain run at the same dt) are third to fourth "
+    "order in time, and at dt = 0.025 their error in time (2e-6) is below the error in space "
+    "of 4 x P2 (1e-4), so the mesh sets it: 8 x P2 costs little more per iteration. At "
+    "equal dt beamfx's planar model has fewer unknowns (4 quadratic elements, 27) than "
+    "Exudyn's 32 two-node elements (99). The Exudyn hub angle is a Python offset user "
+    "function, called at every Newton iteration. Exudyn's Newton absolute tolerance had to "
+    "be raised to 1e-6 N: at its default, Newton stalls at round-off (EA = 2.8e7) and the "
+    "adaptive step collapses (95 s instead of 0.6 s). With the plain scheme beamfx needs "
+    "dt = 0.00625 (4 x P2, 4882 Newton iterations) for Exudyn's best error (32 elements at "
+    "dt = 0.00125), at a wall time within a few per cent of Exudyn's: its cost per step "
+    "(about 0.4 ms, 27 unknowns) is several times Exudyn's (0.2 ms per step at 99 unknowns), "
+    "the assembly through DOLFINx/PETSc per step dominating at this size. The extrapolated "
+    "rows at dt = 0.025 take about 5100 iterations, and their error is that of the mesh "
+    "(4 x P2: 1e-4, 8 x P2: 7e-6). Near 1e-3 extrapolation does not pay: its coarsest "
+    "usable dt is 0.025 (at 0.05 the base with ρ∞ = 0.8 needs cut-backs; with ρ∞ = 0.5 "
+    "the mean stretch is off by 1.3 %), which costs more than the plain run at dt = 0.0125.",
+    "bend45": "Reference withheld: the finest beamfx setting (32 x P4). Exudyn's two-node "
+    "elements on the arc (nodes on the circle, chord lengths) converge at second order.",
+}
+
+
+def _fmt(x, f="{:.2e}"):
+    return "—" if x is None else f.format(x)
+
+
+def _g(x):
+    return _fmt(x, "{:.3g}")
+
+
+def plot(records, problem, title, path, target=None):
+    """Error against whole-run time of every code on ``problem`` (log-log), beamfx's
+    solve-only times dotted beside its whole runs; saved to ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .peers import line
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    groups = {}
+    for r in records:
+        if r["problem"] == problem and r.get("error") and r.get("whole_s"):
+            groups.setdefault(line(r), []).append(r)
+    for name, group in sorted(groups.items(), key=lambda g: g[1][0]["code"] != "beamfx"):
+        group.sort(key=lambda r: r["whole_s"])
+        fx = group[0]["code"] == "beamfx"
+        (h,) = ax.loglog(
+            [r["whole_s"] for r in group],
+            [r["error"] for r in group],
+            "o-" if fx else "s--",
+            label=f"{name}, whole run",
+        )
+        if fx and all(r.get("wall_s") for r in group):
+            solve = sorted(group, key=lambda r: r["wall_s"])
+            x, y = [r["wall_s"] for r in solve], [r["error"] for r in solve]
+            ax.loglog(x, y, ":", color=h.get_color(), alpha=0.6, label="beamfx, solve only")
+    if target:
+        ax.axhline(target, color="grey", lw=0.8, ls=":", label=f"target {target:.1e}")
+    ax.set_xlabel("whole-run wall time (warm process) [s]")
+    ax.set_ylabel("error")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+INTRO = (
+    "Generated by `make bench-peers`: the peer codes run in their own environment "
+    "(`.venv-peers`; CalculiX from Debian), then beamfx, on the same machine in one run (a "
+    "shared 2-core machine: times are noisy, ±30 %). Errors use the metric and reference of "
+    "the beamfx case (the reference of withheld cases is the finest beamfx setting, marked "
+    "*reference* and not scored). Target = the larger of 1e-6 and the best error any peer "
+    "reaches. **Times are whole runs** as a user waits for them in a warm process: for beamfx "
+    "the scene through `run_scene` (the call behind `beamfx run`: model, solve, probes, output "
+    "as the scene asks), for a peer its model build and solve; *solve* is the solve alone. "
+    "*process* adds the one-off start: for beamfx `beamfx run` of that setting timed from "
+    "outside (interpreter, imports, form cache, model, solve, output); for a peer a fresh "
+    "interpreter importing it plus its first run (numba JIT and first calls included); for "
+    "CalculiX its first `ccx` run. beamfx is *ahead* when its whole run reaches the target "
+    "in less time than every peer's that reaches it; the solve-only verdict is beside it. "
+    "Linear space frames beside OpenSeesPy: [peers_frames.md](peers_frames.md)."
+)
+
+
+def _beamfx_cell(s):
+    fx = s["beamfx_at_target"]
+    if fx is None:
+        return "—"
+    return (
+        f"{_g(fx['whole_s'])} ({fx['setting']}; solve {_g(s['beamfx_solve_time'])}; "
+        f"process {_g(fx.get('process_s'))})"
+    )
+
+
+def _peer_cell(name, v):
+    if v["best_error"] is None:
+        return f"{name}: {v['note'] or 'not run'}"
+    if v["time_to_target"] is None:
+        return f"{name}: — (best {v['best_error']:.1e})"
+    return (
+        f"{name}: {_g(v['time_to_target'])} ({v['setting_at_target']}; solve "
+        f"{_g(v['solve_to_target'])}; process {_g(v['process_at_target'])}; best "
+        f"{v['best_error']:.1e})"
+    )
+
+
+def _yes(x):
+    return "yes" if x else "**no**"
+
+
+def summary_table(records, problems):
+    """The summary table and, where beamfx is not ahead, by how much (lines of markdown)."""
+    from .peers import summary
+
+    lines = [
+        (
+            "| problem | target | beamfx: whole s (setting; solve; process) | peers: whole s to "
+            "target (setting; solve; process; best error) | ahead, whole run | ahead, solve only |"
+        ),
+        "|---|---|---|---|---|---|",
+    ]
+    behind = []
+    for pid in problems:
+        s = summary(records, pid)
+        cells = [_peer_cell(n, v) for n, v in s["lines"].items() if v["code"] != "beamfx"]
+        lines.append(
+            f"| {pid} | {s['target']:.1e} | {_beamfx_cell(s)} | "
+            + "<br>".join(cells or ["no peer"])
+            + f" | {_yes(s['beamfx_ahead'])} | {_yes(s['beamfx_ahead_solve'])} |"
+        )
+        if not s["beamfx_ahead"]:
+            behind.append(_behind(pid, s))
+    if behind:
+        lines += ["", "Where beamfx is not ahead on whole runs, by how much (why: the sections):"]
+        lines += [""] + behind
+    return lines
+
+
+def _behind(pid, s):
+    """One bullet: beamfx's whole run against the fastest peer's, and what the run is made of."""
+    fx, fastest = s["beamfx_at_target"], s["fastest_peer"]
+    if fx is None:
+        return f"- **{pid}**: beamfx does not reach the target {s['target']:.1e}."
+    name, t = fastest
+    rest = fx["whole_s"] - fx["wall_s"] if fx.get("wall_s") is not None else None
+    return (
+        f"- **{pid}**: beamfx {_g(fx['whole_s'])} s ({fx['setting']}) against {name} "
+        f"{_g(t)} s: {fx['whole_s'] / t:.2g} x the time. Of beamfx's whole run "
+        f"{_g(fx.get('wall_s'))} s is the solve and {_g(rest)} s the rest (model, forms from "
+        "the cache, probes, output)."
+    )
+
+
+def problem_section(records, pid, meta, s, note=None):
+    """Markdown lines of one problem: target, plot, every record, the note."""
+    from .peers import line
+
+    out = [
+        "",
+        f"## {pid}: {meta.get('title', '')}",
+        "",
+        f"beamfx case `{meta.get('beamfx_case', '')}`; target error {s['target']:.1e}.",
+        "",
+        f"![error against whole-run time, {pid}](peers_{pid}.png)",
+        "",
+        "| code (element) | setting | unknowns | whole s | first s | solve s | process s | error |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    mine = [r for r in records if r["problem"] == pid]
+    mine.sort(
+        key=lambda r: (r["code"] != "beamfx", line(r), r.get("unknowns") or 0, r["wall_s"] or 0)
+    )
+    for r in mine:
+        err = "reference" if r.get("is_reference") else _fmt(r.get("error"))
+        if r.get("error") is None and not r.get("is_reference") and r.get("note"):
+            err = r["note"]
+        times = " | ".join(_g(r.get(k)) for k in ("whole_s", "first_s", "wall_s", "process_s"))
+        out.append(f"| {line(r)} | {r['setting']} | {r.get('unknowns') or '—'} | {times} | {err} |")
+    return out + (["", note] if note else [])
+
+
+def markdown(records, problems, notes=None):
+    """The report: the summary table (whole runs to the target per code), by how much beamfx
+    is behind where it is, then per problem the full table, its plot and its note."""
+    from .peers import summary
+
+    lines = ["# beamfx beside its peers", "", INTRO, "", *summary_table(records, problems)]
+    for pid, meta in problems.items():
+        note = (notes or {}).get(pid)
+        lines += problem_section(records, pid, meta, summary(records, pid), note)
+    return "\n".join(lines) + "\n"
