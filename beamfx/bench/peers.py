@@ -295,19 +295,23 @@ def load_peer_notes(peer_dir):
 
 def measure_processes(records, problems, log=print):
     """``beamfx run`` timed from outside (:func:`.process.process_seconds`) for the beamfx
-    setting of each problem that reaches the target in the least whole-run time."""
+    setting of each problem that reaches the target in the least whole-run time, where not
+    yet measured; returns how many were measured."""
     import tempfile
 
     from .process import process_seconds
 
+    measured = 0
     for pid, meta in problems.items():
         fx = summary(records, pid)["beamfx_at_target"]
         if fx is None or fx.get("process_s") is not None or not fx.get("case_setting"):
             continue
         with tempfile.TemporaryDirectory(prefix="beamfx-peers-") as folder:
             fx["process_s"] = process_seconds(meta["beamfx_case"], fx["case_setting"], folder)
+        measured += 1
         if log:
             log(f"beamfx {pid} {fx['setting']}: beamfx run process {fx['process_s']:.2f} s")
+    return measured
 
 
 def merge(peer_dir, report_dir, run=True, log=print):
@@ -327,8 +331,8 @@ def merge(peer_dir, report_dir, run=True, log=print):
     notes = NOTES | (json.loads(notes_file.read_text()) if notes_file.exists() else {})
     for pid, text in load_peer_notes(peer_dir).items():
         notes[pid] = f"{notes[pid]} {text}" if pid in notes else text
-    if run:
-        measure_processes(records, problems, log)
+    if measure_processes(records, problems, log):  # kept for a later --no-run merge
+        (peer_dir / "beamfx.json").write_text(json.dumps({"references": refs, "records": fx}))
     report.mkdir(parents=True, exist_ok=True)
     for pid, meta in problems.items():
         plot(
