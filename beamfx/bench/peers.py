@@ -1,6 +1,6 @@
 """beamfx beside the open codes users would pick instead ("peers"), measured in one run.
 
-``make bench-peers`` runs three steps (see ``peers/README.md``)::
+``make bench-peers`` runs these steps (and the frames beside OpenSeesPy, see ``peers/README.md``)::
 
     python -m beamfx.bench.peers export DIR         # problems.json: what the peer scripts read
     .venv-peers/bin/python peers/<code>_cases.py DIR  # Exudyn, PyElastica, CalculiX: <code>.json
