@@ -221,6 +221,7 @@ def _line_summary(group, target):
         "code": group[0]["code"],
         "time_to_target": time_to(group, target),
         "solve_to_target": time_to(group, target, "wall_s"),
+        "solve_at_target": None if fastest is None else fastest.get("wall_s"),
         "process_at_target": None if fastest is None else fastest.get("process_s"),
         "setting_at_target": None if fastest is None else fastest["setting"],
         "best_error": best["error"] if best else None,
@@ -252,8 +253,9 @@ def summary(records, problem):
     out = {"target": target, "lines": {n: _line_summary(g, target) for n, g in groups.items()}}
     t_fx, ahead, fastest = _ahead(out["lines"], "time_to_target")
     out |= {"beamfx_time": t_fx, "beamfx_ahead": ahead, "fastest_peer": fastest}
-    t_solve, ahead_solve, _ = _ahead(out["lines"], "solve_to_target")
+    t_solve, ahead_solve, fastest_solve = _ahead(out["lines"], "solve_to_target")
     out |= {"beamfx_solve_time": t_solve, "beamfx_ahead_solve": ahead_solve}
+    out["fastest_peer_solve"] = fastest_solve
     fx = at_target([r for r in rows if r["code"] == "beamfx"], target)
     out["beamfx_at_target"] = fx
     return out

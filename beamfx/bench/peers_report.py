@@ -143,7 +143,7 @@ def _beamfx_cell(s):
     if fx is None:
         return "—"
     return (
-        f"{_g(fx['whole_s'])} ({fx['setting']}; solve {_g(s['beamfx_solve_time'])}; "
+        f"{_g(fx['whole_s'])} ({fx['setting']}; solve {_g(fx.get('wall_s'))}; "
         f"process {_g(fx.get('process_s'))})"
     )
 
@@ -155,13 +155,21 @@ def _peer_cell(name, v):
         return f"{name}: — (best {v['best_error']:.1e})"
     return (
         f"{name}: {_g(v['time_to_target'])} ({v['setting_at_target']}; solve "
-        f"{_g(v['solve_to_target'])}; process {_g(v['process_at_target'])}; best "
+        f"{_g(v['solve_at_target'])}; process {_g(v['process_at_target'])}; best "
         f"{v['best_error']:.1e})"
     )
 
 
 def _yes(x):
     return "yes" if x else "**no**"
+
+
+def _solve_verdict(s):
+    """The solve-only verdict with beamfx's and the fastest peer's least solve times."""
+    fastest = s["fastest_peer_solve"]
+    if s["beamfx_solve_time"] is None or fastest is None:
+        return _yes(s["beamfx_ahead_solve"])
+    return f"{_yes(s['beamfx_ahead_solve'])} ({_g(s['beamfx_solve_time'])} vs {_g(fastest[1])})"
 
 
 def summary_table(records, problems):
@@ -171,7 +179,8 @@ def summary_table(records, problems):
     lines = [
         (
             "| problem | target | beamfx: whole s (setting; solve; process) | peers: whole s to "
-            "target (setting; solve; process; best error) | ahead, whole run | ahead, solve only |"
+            "target (setting; solve; process; best error) | ahead, whole run | ahead, solve only "
+            "(least solve s: beamfx vs fastest peer) |"
         ),
         "|---|---|---|---|---|---|",
     ]
@@ -182,7 +191,7 @@ def summary_table(records, problems):
         lines.append(
             f"| {pid} | {s['target']:.1e} | {_beamfx_cell(s)} | "
             + "<br>".join(cells or ["no peer"])
-            + f" | {_yes(s['beamfx_ahead'])} | {_yes(s['beamfx_ahead_solve'])} |"
+            + f" | {_yes(s['beamfx_ahead'])} | {_solve_verdict(s)} |"
         )
         if not s["beamfx_ahead"]:
             behind.append(_behind(pid, s))

@@ -66,7 +66,7 @@ def test_verdict_on_whole_runs_with_the_solve_only_verdict_beside_it():
     assert not s["beamfx_ahead"] and s["beamfx_ahead_solve"]
     assert s["fastest_peer"] == ("Exudyn (GE)", 0.2)
     md = peers.markdown(recs, {"p": {"title": "fake", "beamfx_case": "c"}})
-    assert "| **no** | yes |" in md
+    assert "| **no** | yes (0.01 vs 0.1) |" in md
     assert "beamfx 0.5 s (4 x P4) against Exudyn (GE) 0.2 s: 2.5 x the time" in md
 
 
