@@ -212,7 +212,8 @@ def _behind(pid, s):
         f"- **{pid}**: beamfx {_g(fx['whole_s'])} s ({fx['setting']}) against {name} "
         f"{_g(t)} s: {fx['whole_s'] / t:.2g} x the time. Of beamfx's whole run "
         f"{_g(fx.get('wall_s'))} s is the solve and {_g(rest)} s the rest (model, forms from "
-        "the cache, probes, output)."
+        "the cache, and per step the work outside the Newton solves: probes, output, step "
+        "control)."
     )
 
 
