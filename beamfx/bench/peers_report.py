@@ -88,7 +88,7 @@ def plot(records, problem, title, path, target=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .peers import line
+    from .peers_score import line
 
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     groups = {}
@@ -174,7 +174,7 @@ def _solve_verdict(s):
 
 def summary_table(records, problems):
     """The summary table and, where beamfx is not ahead, by how much (lines of markdown)."""
-    from .peers import summary
+    from .peers_score import summary
 
     lines = [
         (
@@ -219,7 +219,7 @@ def _behind(pid, s):
 
 def problem_section(records, pid, meta, s, note=None):
     """Markdown lines of one problem: target, plot, every record, the note."""
-    from .peers import line
+    from .peers_score import line
 
     out = [
         "",
@@ -248,7 +248,7 @@ def problem_section(records, pid, meta, s, note=None):
 def markdown(records, problems, notes=None):
     """The report: the summary table (whole runs to the target per code), by how much beamfx
     is behind where it is, then per problem the full table, its plot and its note."""
-    from .peers import summary
+    from .peers_score import summary
 
     lines = ["# beamfx beside its peers", "", INTRO, "", *summary_table(records, problems)]
     for pid, meta in problems.items():
