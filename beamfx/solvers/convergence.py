@@ -14,7 +14,10 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
   tangent's entries in absolute value, s a size per unknown added to the state, e.g. the
   element length for displacements, so that the terms of the reference geometry count), and
   ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too, or
-  the floor is the model's own at its reference geometry: a small load on a stiff model),
+  the floor is the model's own at its reference geometry: a small load on a stiff model, or
+  the floor is the model's stiffness ratio at a state within :data:`STATE_RANGE` times the
+  reference sizes and Newton has stopped, its corrections at round-off of the state,
+  ‖du‖ ≤ :data:`ROUNDOFF_TOL`·‖|x| + s‖, and no longer decreasing: EA, GA ≫ EI/L²),
   *and* the increment criteria hold: the last correction is small against the state,
   ‖du‖ ≤ :data:`INCREMENT_TOL`·‖|x| + s‖ (or :data:`SETTLED_TOL`·‖|x| + s‖ once the
   corrections stagnate: round-off moves the state, Newton no longer does), and its
