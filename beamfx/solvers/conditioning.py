@@ -91,7 +91,7 @@ def condition_estimate(A, fixed_rows, limit=LIMIT):
             "unscaled": _finite(unscaled),
             "scaling": SCALING,
             "norm": norm,
-            "free_unknowns": int(len(free)),
+            "free_unknowns": len(free),
         }
     return comm.bcast(out, root=0)
 
