@@ -107,8 +107,8 @@ nu = 0.3
 name = "b"
 curve = { shape = "line", start = [0, 0, 0], end = [1, 0, 0] }
 section = { type = "rectangle", h = 0.02, w = 0.01 }
-elements = 1
-degree = 4
+elements = 2
+degree = 3
 
 [model]
 kinematics = "linear"
