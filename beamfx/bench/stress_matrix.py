@@ -222,7 +222,8 @@ def main(ids=()):
 
     cases = [c for c in all_cases().values() if type(c).__name__ not in SKIP]
     cases = [c for c in cases if not ids or c.id in ids]
-    results, failing = [], []
+    results, failing, findings = [], [], findings_of(OUT)
+    OUT.parent.mkdir(parents=True, exist_ok=True)
     for case in cases:
         for setting in settings_by_degree(case):
             print(f"{case.id} {setting} ...", flush=True)
@@ -230,8 +231,7 @@ def main(ids=()):
             results.append((case, setting, rows))
             if not verdict(case, rows)[0]:
                 failing.append(f"{case.id} {setting[0]}×P{setting[1]}")
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(markdown(results, findings_of(OUT)))
+            OUT.write_text(markdown(results, findings))  # after each setting: a long run
     print(f"wrote {OUT}; not passing: {failing}")
     return failing
 
