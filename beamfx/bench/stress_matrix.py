@@ -3,8 +3,9 @@ with EA and GA multiplied by 1, 1e2, 1e4, 1e6 and 1e8, at one setting per degree
 the case has: converged or not, how far its answer moves, and the condition number of the
 tangent (static runs). Writes ``docs/validation/stress_matrix.md``.
 
-Run ``python -m beamfx.bench.stress_matrix [case ids...]`` (all cases take many minutes: not
-part of ``make bench``). The stiffnesses are multiplied where the model reads them
+Run ``python -m beamfx.bench.stress_matrix [case ids...]`` (all cases: about half an hour;
+not part of ``make bench``); the runs are saved next to the report (``stress_matrix.json``),
+and ``python -m beamfx.bench.stress_matrix --render`` writes the report again from them. The stiffnesses are multiplied where the model reads them
 (:meth:`~beamfx.physics.sections.Section.stiffnesses`, patched for the run), so every case
 runs as its own bench run does, scenes and the penalty limits included (a shear-rigid or
 inextensible case has its penalty multiplied too). Static and SceneCase settings run once
@@ -19,6 +20,7 @@ their trend (the move from the previous factor) must fall, by half at least, unt
 """
 
 import itertools
+import json
 import re
 import sys
 import tempfile
@@ -134,14 +136,21 @@ def _cause(message):
 
 
 def move(values, reference, scale=None):
-    """Largest relative change of the named values (or change / ``scale``)."""
+    """Largest relative change of the named values (or change / ``scale``; the change itself
+    where the reference value is 0, e.g. a flag)."""
     if values is None or reference is None:
         return None
     out = 0.0
     for key, ref in reference.items():
         d = abs(values[key] - ref)
-        out = max(out, d / scale if scale else d / max(abs(ref), 1e-300))
+        out = max(out, d / scale if scale else d / abs(ref) if ref else d)
     return out
+
+
+def falls(trend):
+    """Whether a trend (moves from factor to factor) falls: each move at most half the one
+    before, or below :data:`TOLERANCE`."""
+    return all(t <= TOLERANCE or t <= 0.5 * p for p, t in itertools.pairwise(trend))
 
 
 def verdict(case, rows):
@@ -154,10 +163,21 @@ def verdict(case, rows):
     if case.id in INDEPENDENT:
         worst = max(moves)
         return worst <= TOLERANCE, f"moves {worst:.1e} (independent of EA, GA)"
-    trend = [move(b["values"], a["values"], case.scale) for a, b in itertools.pairwise(rows)]
-    falling = all(t <= TOLERANCE or t <= 0.5 * p for p, t in itertools.pairwise(trend))
-    text = "trend " + " → ".join(f"{t:.0e}" for t in trend)
-    return falling, text + (" (converges)" if falling else " (does not fall)")
+    trends = {
+        key: [move(_one(b, key), _one(a, key), case.scale) for a, b in itertools.pairwise(rows)]
+        for key in rows[0]["values"]
+    }
+    bad = {key: t for key, t in trends.items() if not falls(t)}
+    show = lambda t: " → ".join(f"{x:.0e}" for x in t)
+    if bad:
+        return False, "; ".join(f"{k}: {show(t)} (does not fall)" for k, t in bad.items())
+    worst = [max(t) for t in zip(*trends.values(), strict=True)]
+    return True, f"trend {show(worst)} (converges, each value)"
+
+
+def _one(row, key):
+    """The row's value ``key`` alone (a dict for :func:`move`)."""
+    return {key: row["values"][key]}
 
 
 def table_rows(case, setting, rows):
@@ -232,9 +252,29 @@ def main(ids=()):
             if not verdict(case, rows)[0]:
                 failing.append(f"{case.id} {setting[0]}×P{setting[1]}")
             OUT.write_text(markdown(results, findings))  # after each setting: a long run
+            save(results, OUT.with_suffix(".json"))
     print(f"wrote {OUT}; not passing: {failing}")
     return failing
 
 
+def save(results, path):
+    """The runs as JSON (case id, setting, rows), to render the report again (:func:`render`)."""
+    data = [{"case": c.id, "setting": list(s), "rows": rows} for c, s, rows in results]
+    path.write_text(json.dumps(data, indent=1))
+
+
+def render(path=None):
+    """Rewrite :data:`OUT` from the saved runs (after a change of the verdicts or the text)."""
+    from . import all_cases
+
+    cases = all_cases()
+    data = json.loads((path or OUT.with_suffix(".json")).read_text())
+    results = [(cases[d["case"]], tuple(d["setting"]), d["rows"]) for d in data]
+    OUT.write_text(markdown(results, findings_of(OUT)))
+
+
 if __name__ == "__main__":
-    main(tuple(sys.argv[1:]))
+    if sys.argv[1:] == ["--render"]:
+        render()
+    else:
+        main(tuple(sys.argv[1:]))
