@@ -4,7 +4,8 @@ The round-off of a solve grows with the condition number κ of its tangent: a pe
 stiff term (EA, GA ≫ EI/L²) raises κ by the stiffness ratio, and a symmetric diagonal
 scaling D K D (D = diag |K_ii|^(-1/2), each field measured by its own stiffness) removes only
 what the choice of units adds, not that ratio. The estimate is computed on the free dofs (the
-constrained rows and columns, identity in the assembled tangent, removed), gathered on rank 0:
+constrained rows and columns, identity in the assembled tangent, removed), gathered on rank 0
+as a sparse matrix:
 
 * up to :data:`DENSE_LIMIT` free unknowns: κ₂ = σ_max/σ_min, the ratio of the extreme singular
   values (dense SVD, exact);
@@ -24,10 +25,12 @@ LIMIT = 2000
 SCALING = "symmetric diagonal D K D, D = diag(|K_ii|)^(-1/2) on the free dofs"
 
 
-def gather_dense(A, fixed_rows):
-    """(K, free) on rank 0, (None, None) elsewhere: the dense matrix ``A`` (PETSc, global
-    size n) and the global indices of its free rows (``fixed_rows``: the owned local indices
+def gather(A, fixed_rows):
+    """(K, free) on rank 0, (None, None) elsewhere: the PETSc matrix ``A`` as a SciPy CSR
+    matrix and the global indices of its free rows (``fixed_rows``: the owned local indices
     of the constrained rows on each rank). Collective."""
+    import scipy.sparse as sp
+
     comm = A.getComm().tompi4py()
     n = A.getSize()[0]
     start = A.getOwnershipRange()[0]
@@ -35,40 +38,43 @@ def gather_dense(A, fixed_rows):
     parts = comm.gather((start, ai, aj, av, np.asarray(fixed_rows, np.int64) + start), root=0)
     if comm.rank != 0:
         return None, None
-    K = np.zeros((n, n))
-    fixed = []
-    for first, indptr, cols, vals, rows in parts:
-        owned = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr)) + first
-        K[owned, cols] = vals
-        fixed.append(rows)
-    free = np.setdiff1d(np.arange(n), np.concatenate(fixed))
+    rows = [np.repeat(np.arange(len(p[1]) - 1), np.diff(p[1])) + p[0] for p in parts]
+    K = sp.csr_matrix(
+        (
+            np.concatenate([p[3] for p in parts]),
+            (np.concatenate(rows), np.concatenate([p[2] for p in parts])),
+        ),
+        shape=(n, n),
+    )
+    free = np.setdiff1d(np.arange(n), np.concatenate([p[4] for p in parts]))
     return K, free
 
 
 def scaled(K):
-    """D K D with D = diag(|K_ii|)^(-1/2) (a zero diagonal entry left unscaled)."""
-    d = np.abs(np.diag(K))
-    d = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
-    return d[:, None] * K * d[None, :]
+    """D K D with D = diag(|K_ii|)^(-1/2) (a zero diagonal entry left unscaled); K sparse."""
+    import scipy.sparse as sp
+
+    d = np.abs(K.diagonal())
+    D = sp.diags(1.0 / np.sqrt(np.where(d > 0, d, 1.0)))
+    return (D @ K @ D).tocsc()
 
 
 def condition(K):
-    """(κ, norm name) of the square matrix ``K``: κ₂ by SVD up to :data:`DENSE_LIMIT` rows,
-    else the 1-norm estimate; inf when K is singular to working precision."""
-    if len(K) <= DENSE_LIMIT:
-        s = np.linalg.svd(K, compute_uv=False)
+    """(κ, norm name) of the square sparse matrix ``K``: κ₂ by a dense SVD up to
+    :data:`DENSE_LIMIT` rows, else the 1-norm estimate; inf when K is singular to working
+    precision."""
+    if K.shape[0] <= DENSE_LIMIT:
+        s = np.linalg.svd(K.toarray(), compute_uv=False)
         return (float(s[0] / s[-1]) if s[-1] > 0 else np.inf), "2"
-    import scipy.sparse as sp
     from scipy.sparse.linalg import LinearOperator, onenormest, splu
 
-    S = sp.csc_matrix(K)
+    S = K.tocsc()
     try:
         lu = splu(S)
     except RuntimeError:  # exactly singular
         return np.inf, "1 (estimate)"
-    n = len(K)
     inverse = LinearOperator(
-        (n, n), matvec=lu.solve, rmatvec=lambda y: lu.solve(y, trans="T"), dtype=float
+        S.shape, matvec=lu.solve, rmatvec=lambda y: lu.solve(y, trans="T"), dtype=float
     )
     return float(onenormest(S) * onenormest(inverse)), "1 (estimate)"
 
@@ -80,10 +86,10 @@ def condition_estimate(A, fixed_rows, limit=LIMIT):
     comm = A.getComm().tompi4py()
     if A.getSize()[0] > limit:
         return None
-    K, free = gather_dense(A, fixed_rows)
+    K, free = gather(A, fixed_rows)
     out = None
     if comm.rank == 0:
-        K = K[np.ix_(free, free)]
+        K = K[free][:, free]
         value, norm = condition(scaled(K))
         unscaled, _ = condition(K)
         out = {
