@@ -24,6 +24,10 @@ section = {{ type = "circle", d = {d!r} }}
 elements = 6
 degree = 2
 
+[model]  # the full 3D model (a planar or condensed one has other unknowns)
+plane = "none"
+condense = "none"
+
 [[supports]]
 at = "b:start"
 fix = "all"
@@ -114,6 +118,7 @@ degree = 3
 [model]
 kinematics = "linear"
 shear = false
+plane = "none"
 
 [[supports]]
 at = "b:start"
