@@ -236,12 +236,14 @@ def findings_of(path):
 
 
 def main(ids=()):
-    """Run the matrix (all cases, or ``ids`` in their order) and write :data:`OUT`; returns
-    the settings that do not pass."""
+    """Run the matrix (all cases, or ``ids`` in their order: their rows replace theirs in the
+    saved runs, the other cases' are kept) and write :data:`OUT`; returns the settings that
+    do not pass."""
     from . import all_cases
 
     every = {k: c for k, c in all_cases().items() if type(c).__name__ not in SKIP}
     cases = [every[i] for i in ids if i in every] if ids else list(every.values())
+    saved = load() if ids and OUT.with_suffix(".json").exists() else []
     results, failing, findings = [], [], findings_of(OUT)
     OUT.parent.mkdir(parents=True, exist_ok=True)
     for case in cases:
@@ -251,10 +253,25 @@ def main(ids=()):
             results.append((case, setting, rows))
             if not verdict(case, rows)[0]:
                 failing.append(f"{case.id} {setting[0]}×P{setting[1]}")
-            OUT.write_text(markdown(results, findings))  # after each setting: a long run
-            save(results, OUT.with_suffix(".json"))
+            merged = merge(saved, results)
+            OUT.write_text(markdown(merged, findings))  # after each setting: a long run
+            save(merged, OUT.with_suffix(".json"))
     print(f"wrote {OUT}; not passing: {failing}")
     return failing
+
+
+def merge(saved, new):
+    """The saved runs with those of the cases in ``new`` replaced (in place; new cases last)."""
+    ids = {c.id for c, _, _ in new}
+    out, placed = [], set()
+    for entry in saved:
+        case_id = entry[0].id
+        if case_id not in ids:
+            out.append(entry)
+        elif case_id not in placed:
+            out += [e for e in new if e[0].id == case_id]
+            placed.add(case_id)
+    return out + [e for e in new if e[0].id not in placed]
 
 
 def save(results, path):
@@ -263,14 +280,18 @@ def save(results, path):
     path.write_text(json.dumps(data, indent=1))
 
 
-def render(path=None):
-    """Rewrite :data:`OUT` from the saved runs (after a change of the verdicts or the text)."""
+def load(path=None):
+    """The saved runs: [(case, setting, rows)]."""
     from . import all_cases
 
     cases = all_cases()
     data = json.loads((path or OUT.with_suffix(".json")).read_text())
-    results = [(cases[d["case"]], tuple(d["setting"]), d["rows"]) for d in data]
-    OUT.write_text(markdown(results, findings_of(OUT)))
+    return [(cases[d["case"]], tuple(d["setting"]), d["rows"]) for d in data]
+
+
+def render(path=None):
+    """Rewrite :data:`OUT` from the saved runs (after a change of the verdicts or the text)."""
+    OUT.write_text(markdown(load(path), findings_of(OUT)))
 
 
 if __name__ == "__main__":

@@ -90,3 +90,14 @@ def test_the_saved_runs_render_the_same_report(tmp_path, monkeypatch):
     assert text == sm.markdown(results, "## Findings\n\nkept\n")
     # its scale is 10: the move 2e-5 counts as 2e-6
     assert "| rollup_1 | 8×P4 | NO | moves 2.0e-06 (independent of EA, GA) |" in text
+
+
+def test_a_rerun_replaces_its_cases_rows_in_place():
+    a, b, c = case("a"), case("b"), case("c")
+    saved = [(a, (1, 2), "old a2"), (a, (1, 3), "old a3"), (b, (1, 2), "old b")]
+    new = [(a, (2, 3), "new a"), (c, (1, 2), "new c")]
+    assert sm.merge(saved, new) == [
+        (a, (2, 3), "new a"),
+        (b, (1, 2), "old b"),
+        (c, (1, 2), "new c"),
+    ]
