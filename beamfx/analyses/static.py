@@ -5,7 +5,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..solvers import NewtonSolver, step_load
+from ..solvers import NewtonSolver, SolveFailed, step_load
 from ..solvers.stepping import SavedState
 
 
@@ -128,6 +128,9 @@ def solve_static(
 
     try:
         history = step_load(solve_at, _State(model.w), steps=n, on_step=accepted, log=log)
+    except SolveFailed as e:  # the tangent at the last converged state (restored): κ·eps ≥ 1
+        e.details["condition_estimate"] = tangent_condition(solver)  # says why
+        raise
     finally:
         if counted is not None:
             counted.destroy()

@@ -154,3 +154,18 @@ def test_a_shear_rigid_cantilever_converges_far_beyond_the_penalty(tmp_path, fac
     EI = 210e9 * 0.01 * 0.02**3 / 12
     uz = r["probes"]["tip"]["displacement"][2]
     assert uz == pytest.approx(1e4 / (3 * EI), rel=1e-6)
+
+
+def test_beyond_double_precision_the_failure_says_how_ill_conditioned(tmp_path):
+    """EA and GA 1e8 times larger on the shear-rigid cantilever: GA L²/EI = 1e16, the tangent
+    is singular in double precision (κ ≥ 1/eps) and Newton cannot converge; the run fails
+    (exit status 3 in ``beamfx run``) and its failure entry holds the condition estimate of
+    the tangent at the last converged state (the undeformed one), at least 1e16 or None
+    (singular to working precision)."""
+    from beamfx.bench.stress_matrix import stiffened
+
+    with stiffened(1e8):
+        r = run(tmp_path, SHEAR_RIGID)
+    assert r["converged"] is False and r["status"] == "failed"
+    kappa = r["failure"]["condition_estimate"]
+    assert kappa["value"] is None or kappa["value"] >= 1e16
