@@ -5,7 +5,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..solvers import NewtonSolver, step_load
+from ..solvers import NewtonSolver, SolveFailed, step_load
 from ..solvers.stepping import SavedState
 
 
@@ -17,6 +17,7 @@ class StaticResult(NamedTuple):
     seconds: dict  # wall time of this call: compile, assemble_F, assemble_J, solve (factorise,
     # triangular_solve, python), total
     negative_eigenvalues: tuple = ()  # of the tangent after each accepted step (or empty)
+    condition_estimate: dict | None = None  # of the tangent at the last state (small models)
 
 
 class _State(SavedState):
@@ -127,15 +128,42 @@ def solve_static(
 
     try:
         history = step_load(solve_at, _State(model.w), steps=n, on_step=accepted, log=log)
+    except SolveFailed as e:  # the tangent at the last converged state (restored): κ·eps ≥ 1
+        e.details["condition_estimate"] = tangent_condition(solver)  # says why
+        raise
     finally:
         if counted is not None:
             counted.destroy()
     spent = {k: v - before.get(k, 0.0) for k, v in solver.seconds.items()}
     if counted is not None:
         spent["inertia"] = counted.seconds
+    t1 = time.perf_counter()
+    kappa = tangent_condition(solver)
+    spent["condition"] = time.perf_counter() - t1
     seconds = {"compile": compile_time, **spent, "total": time.perf_counter() - t0}
     its = int(np.sum([h.iterations for h in history]))
-    return StaticResult(tuple(history), its, seconds, tuple(counts))
+    return StaticResult(tuple(history), its, seconds, tuple(counts), kappa)
+
+
+def tangent_condition(solver):
+    """The condition estimate (:mod:`~beamfx.solvers.conditioning`) of the tangent at the
+    solver's current state (assembled once more), or None for a large model. Collective."""
+    import dolfinx.fem.petsc as fp
+
+    from ..solvers.assembly import assemble_tangent
+    from ..solvers.conditioning import LIMIT, condition_estimate
+    from ..solvers.snes import constrained_rows
+
+    A = fp.create_matrix(solver.J)
+    try:
+        if A.getSize()[0] > LIMIT:
+            return None
+        assemble_tangent(A, solver.J, solver.bcs)
+        if solver.coupling:
+            solver.coupling.add_to_tangent(A)
+        return condition_estimate(A, constrained_rows(solver.bcs, A.getLocalSize()[0]))
+    finally:
+        A.destroy()
 
 
 def _inertia_counter(model, inertia):

@@ -29,6 +29,10 @@ class Result(_Base):
 
     fallback: str | None = entry("why the statically condensed model was replaced, or None")
     path: tuple = entry("load factor and the probes' values after every accepted load step")
+    condition_estimate: dict | None = entry(
+        "condition number of the tangent at the last state (free dofs, scaled and unscaled; "
+        "models of at most 2000 unknowns), or None"
+    )
 
 
 def solve(model: Formulation, settings: Settings, ctx: RunContext) -> tuple["StaticResult", tuple]:
@@ -94,6 +98,7 @@ def run(model: Formulation, settings: Settings, ctx: RunContext) -> Result:
         seconds=dict(solved.seconds),
         fallback=fallback,
         path=path,
+        condition_estimate=solved.condition_estimate,
     )
 
 

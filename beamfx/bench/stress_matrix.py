@@ -1,19 +1,29 @@
 """The stress matrix (issue 16): every static, buckling, modal and rotating benchmark re-run
-with EA and GA multiplied by 1, 1e2, 1e4, 1e6 and 1e8 at one mid setting: converged or not,
-and how far its answer moves. Writes ``docs/validation/stress_matrix.md``.
+with EA and GA multiplied by 1, 1e2, 1e4, 1e6 and 1e8, at one setting per degree 2, 3, 4 that
+the case has: converged or not, how far its answer moves, and the condition number of the
+tangent (static runs). Writes ``docs/validation/stress_matrix.md``.
 
-Run ``python -m beamfx.bench.stress_matrix [case ids...]`` (all cases take many minutes: not
-part of ``make bench``). The stiffnesses are multiplied where the model reads them
+Run ``python -m beamfx.bench.stress_matrix [case ids...]`` (all cases: about half an hour;
+not part of ``make bench``); the runs are saved next to the report (``stress_matrix.json``),
+and ``python -m beamfx.bench.stress_matrix --render`` writes the report again from them. The stiffnesses are multiplied where the model reads them
 (:meth:`~beamfx.physics.sections.Section.stiffnesses`, patched for the run), so every case
-runs as its own bench run does, scenes and the penalty limits included.
+runs as its own bench run does, scenes and the penalty limits included (a shear-rigid or
+inextensible case has its penalty multiplied too). Static and SceneCase settings run once
+through ``beamfx run``'s path (:mod:`.scenes`); the cases with a run of their own (rotating,
+torque buckling, the planar roll-up) through that.
 
 The answers of :data:`INDEPENDENT` cases do not depend on EA and GA (pure bending, or
 inextensible and shear-rigid already): they are flagged when they move by more than
-:data:`TOLERANCE` relative. The others move towards their shear-rigid, inextensible limit; the
-table shows the trend (the move from the previous factor).
+:data:`TOLERANCE` relative. The others move towards their shear-rigid, inextensible limit:
+their trend (the move from the previous factor) must fall, by half at least, until it is below
+:data:`TOLERANCE`.
 """
 
+import itertools
+import json
+import re
 import sys
+import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -58,92 +68,234 @@ def stiffened(factor):
         sections.Section.stiffnesses = original
 
 
-def run_case(case):
-    """Per factor: (converged, values or None, seconds) at the case's mid setting."""
-    from .run import run_setting
+def settings_by_degree(case):
+    """One setting per degree 2, 3, 4 that the case has: the middle one of that degree."""
+    out = []
+    for degree in (2, 3, 4):
+        own = [s for s in case.settings if s[1] == degree]
+        if own:
+            out.append(own[len(own) // 2])
+    return out or [case.settings[len(case.settings) // 2]]
 
-    setting = case.settings[len(case.settings) // 2]
+
+def run_once(case, setting):
+    """(values, path, condition) of one run of ``setting``: through ``beamfx run``'s path for a
+    static Case and a SceneCase, the case's own run otherwise. Raises if it fails."""
+    from .registry import Case
+    from .scenes import SceneCase, case_scene, run_in_process
+
+    elements, degree = setting[:2]
+    if not isinstance(case, SceneCase) and type(case) is not Case:
+        return case.run_setting(elements, degree)["values"], "own", None
+    if isinstance(case, SceneCase):
+        scenes = case.build(elements, degree)
+    else:
+        scenes = [(case_scene(case, elements, degree), None)]
+    runs, values = [], {}
+    with tempfile.TemporaryDirectory(prefix="beamfx-stress-") as folder:
+        for scene, read in scenes:
+            run, _ = run_in_process(scene, folder)
+            if run.result.status != "converged":
+                raise RuntimeError(f"{case.id}: {run.result.status}: {run.result.reason}")
+            values.update(read(run.result) if read else run.probes)
+            runs.append(run)
+    return case.measure(values), "scene", _condition(runs)
+
+
+def _condition(runs):
+    """The largest scaled condition estimate of the runs (static runs have one), or None."""
+    values = [(getattr(r.result, "condition_estimate", None) or {}).get("value") for r in runs]
+    values = [v for v in values if v is not None]
+    return max(values) if values else None
+
+
+def run_setting(case, setting):
+    """Per factor: dict(factor, ok, values, path, kappa, seconds, cause)."""
     rows = []
     for factor in FACTORS:
         t0 = time.perf_counter()
+        row = {"factor": factor, "ok": False, "values": None, "path": "", "kappa": None}
         with stiffened(factor):
             try:
-                row = (
-                    case.run_setting(*setting)
-                    if hasattr(case, "run_setting")
-                    else run_setting(case, *setting[:2])
-                )
-                values = row["values"]
+                values, path, kappa = run_once(case, setting)
+                row.update(ok=True, path=path, kappa=kappa)
+                row["values"] = {k: float(v) for k, v in values.items()}
             except Exception as e:  # noqa: BLE001  (a failed run is the matrix's finding)
-                values = None
-                print(f"  {case.id} x{factor:g}: {type(e).__name__}: {str(e)[:200]}")
-        rows.append((factor, values is not None, values, time.perf_counter() - t0))
-    return setting, rows
+                row["cause"] = _cause(str(e))
+                print(f"  {case.id} {setting} x{factor:g}: {type(e).__name__}: {str(e)[:200]}")
+        row["seconds"] = time.perf_counter() - t0
+        rows.append(row)
+    return rows
+
+
+def _cause(message):
+    """The cause named in a failure message (beamfx's 'cause: X (' or 'cause: X;'), else its
+    first words."""
+    found = re.search(r"cause: ([a-z ]+?)[ ]?[(;]", message)
+    return found.group(1) if found else message[:60]
 
 
 def move(values, reference, scale=None):
-    """Largest relative change of the named values (or change / ``scale``)."""
+    """Largest relative change of the named values (or change / ``scale``; the change itself
+    where the reference value is 0, e.g. a flag)."""
     if values is None or reference is None:
         return None
     out = 0.0
     for key, ref in reference.items():
         d = abs(values[key] - ref)
-        out = max(out, d / scale if scale else d / max(abs(ref), 1e-300))
+        out = max(out, d / scale if scale else d / abs(ref) if ref else d)
     return out
 
 
+def falls(trend):
+    """Whether a trend (moves from factor to factor) falls: each move at most half the one
+    before, or below :data:`TOLERANCE`."""
+    return all(t <= TOLERANCE or t <= 0.5 * p for p, t in itertools.pairwise(trend))
+
+
+def verdict(case, rows):
+    """(passes, what) of one setting's rows: every factor converged, and an independent case
+    moved by at most TOLERANCE, a dependent one with a falling trend."""
+    failed = [f"x{r['factor']:g}" for r in rows if not r["ok"]]
+    if failed:
+        return False, "fails at " + ", ".join(failed)
+    moves = [move(r["values"], rows[0]["values"], case.scale) for r in rows]
+    if case.id in INDEPENDENT:
+        worst = max(moves)
+        return worst <= TOLERANCE, f"moves {worst:.1e} (independent of EA, GA)"
+    trends = {
+        key: [move(_one(b, key), _one(a, key), case.scale) for a, b in itertools.pairwise(rows)]
+        for key in rows[0]["values"]
+    }
+    bad = {key: t for key, t in trends.items() if not falls(t)}
+    show = lambda t: " → ".join(f"{x:.0e}" for x in t)
+    if bad:
+        return False, "; ".join(f"{k}: {show(t)} (does not fall)" for k, t in bad.items())
+    worst = [max(t) for t in zip(*trends.values(), strict=True)]
+    return True, f"trend {show(worst)} (converges, each value)"
+
+
+def _one(row, key):
+    """The row's value ``key`` alone (a dict for :func:`move`)."""
+    return {key: row["values"][key]}
+
+
 def table_rows(case, setting, rows):
-    """Markdown rows of one case: per factor, converged, move from ×1 and from the last."""
-    ref = rows[0][2]
-    lines, flag = [], False
-    for i, (factor, ok, values, seconds) in enumerate(rows):
-        m1 = move(values, ref, case.scale)
-        prev = move(values, rows[i - 1][2], case.scale) if i else None
-        bad = case.id in INDEPENDENT and (not ok or (m1 is not None and m1 > TOLERANCE))
-        flag |= bad or not ok
-        fmt = lambda x: "–" if x is None else f"{x:.1e}"
+    """Markdown rows of one setting: per factor, converged, moves, κ, time, cause."""
+    fmt = lambda x: "–" if x is None else f"{x:.1e}"
+    lines = []
+    for i, r in enumerate(rows):
+        m1 = move(r["values"], rows[0]["values"], case.scale)
+        prev = move(r["values"], rows[i - 1]["values"], case.scale) if i else None
         lines.append(
-            f"| {case.id} | {setting[0]}×P{setting[1]} | {factor:g} | {'yes' if ok else 'NO'} "
-            f"| {fmt(m1)} | {fmt(prev)} | {seconds:.1f} |" + (" **flagged**" if bad else "")
+            f"| {case.id} | {setting[0]}×P{setting[1]} | {r['factor']:g} | "
+            f"{'yes' if r['ok'] else 'NO'} | {fmt(m1)} | {fmt(prev)} | {fmt(r['kappa'])} | "
+            f"{r['seconds']:.1f} | {r['path'] or r.get('cause', '')} |"
         )
-    return lines, flag
+    return lines
+
+
+HEADER = (
+    "Generated by `python -m beamfx.bench.stress_matrix` (not part of `make bench`). EA, GA_y "
+    "and GA_z multiplied by the factor in every section (penalties of shear-rigid and "
+    "inextensible models included). Each case at one setting per degree; *move ×1*: the "
+    "largest relative change of its values from factor 1 (or the change / the case's scale), "
+    "*move prev*: from the previous factor (the trend); *κ*: the condition number of the "
+    "static tangent at the last state, symmetric diagonal scaling (results.json "
+    "`condition_estimate`); *run*: `scene` through `beamfx run`'s path, `own` the case's "
+    "own run, or the cause of a failure."
+)
+
+
+#: the heading of the report's hand-written part, kept when the tables are regenerated
+FINDINGS = "## Findings"
+
+
+def markdown(results, findings=""):
+    """The report: the verdicts, every run, then ``findings`` (hand-written, kept)."""
+    lines = ["# Stress matrix: EA and GA multiplied by 1 … 1e8", "", HEADER, ""]
+    lines += ["| case | setting | passes | what |", "|---|---|---|---|"]
+    for case, setting, rows in results:
+        ok, what = verdict(case, rows)
+        lines.append(
+            f"| {case.id} | {setting[0]}×P{setting[1]} | {'yes' if ok else 'NO'} | {what} |"
+        )
+    lines += ["", "| case | setting | factor | converged | move ×1 | move prev | κ | s | run |"]
+    lines += ["|---|---|---|---|---|---|---|---|---|"]
+    for case, setting, rows in results:
+        lines += table_rows(case, setting, rows)
+    text = "\n".join(lines) + "\n"
+    return text + ("\n" + findings if findings else "")
+
+
+def findings_of(path):
+    """The hand-written part of an existing report (from :data:`FINDINGS` on), or ''."""
+    text = path.read_text() if path.exists() else ""
+    at = text.find(FINDINGS)
+    return text[at:] if at >= 0 else ""
 
 
 def main(ids=()):
-    """Run the matrix (all cases, or ``ids``) and write :data:`OUT`."""
+    """Run the matrix (all cases, or ``ids`` in their order: their rows replace theirs in the
+    saved runs, the other cases' are kept) and write :data:`OUT`; returns the settings that
+    do not pass."""
     from . import all_cases
 
-    cases = [c for c in all_cases().values() if type(c).__name__ not in SKIP]
-    cases = [c for c in cases if not ids or c.id in ids]
-    lines = [
-        "# Stress matrix: EA and GA multiplied by 1 … 1e8",
-        "",
-        (
-            "Generated by `python -m beamfx.bench.stress_matrix` (not part of `make bench`). "
-            "Each "
-            "case at its mid setting; *move ×1*: the largest relative change of its values from "
-            "factor 1 (or the change / the case's scale), *move prev*: from the previous factor "
-            f"(the trend). Cases whose answer does not depend on EA, GA ({', '.join(INDEPENDENT)}) "
-            f"are flagged when they move by more than {TOLERANCE:g} or fail."
-        ),
-        "",
-        "| case | setting | factor | converged | move ×1 | move prev | s |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    flagged = []
-    for case in cases:
-        print(f"{case.id} ...", flush=True)
-        setting, rows = run_case(case)
-        case_lines, flag = table_rows(case, setting, rows)
-        lines += case_lines
-        if flag:
-            flagged.append(case.id)
-    lines += ["", f"Flagged or failed: {', '.join(flagged) if flagged else 'none'}.", ""]
+    every = {k: c for k, c in all_cases().items() if type(c).__name__ not in SKIP}
+    cases = [every[i] for i in ids if i in every] if ids else list(every.values())
+    saved = load() if ids and OUT.with_suffix(".json").exists() else []
+    results, failing, findings = [], [], findings_of(OUT)
     OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text("\n".join(lines))
-    print(f"wrote {OUT}; flagged or failed: {flagged}")
-    return flagged
+    for case in cases:
+        for setting in settings_by_degree(case):
+            print(f"{case.id} {setting} ...", flush=True)
+            rows = run_setting(case, setting)
+            results.append((case, setting, rows))
+            if not verdict(case, rows)[0]:
+                failing.append(f"{case.id} {setting[0]}×P{setting[1]}")
+            merged = merge(saved, results)
+            OUT.write_text(markdown(merged, findings))  # after each setting: a long run
+            save(merged, OUT.with_suffix(".json"))
+    print(f"wrote {OUT}; not passing: {failing}")
+    return failing
+
+
+def merge(saved, new):
+    """The saved runs with those of the cases in ``new`` replaced (in place; new cases last)."""
+    ids = {c.id for c, _, _ in new}
+    out, placed = [], set()
+    for entry in saved:
+        case_id = entry[0].id
+        if case_id not in ids:
+            out.append(entry)
+        elif case_id not in placed:
+            out += [e for e in new if e[0].id == case_id]
+            placed.add(case_id)
+    return out + [e for e in new if e[0].id not in placed]
+
+
+def save(results, path):
+    """The runs as JSON (case id, setting, rows), to render the report again (:func:`render`)."""
+    data = [{"case": c.id, "setting": list(s), "rows": rows} for c, s, rows in results]
+    path.write_text(json.dumps(data, indent=1))
+
+
+def load(path=None):
+    """The saved runs: [(case, setting, rows)]."""
+    from . import all_cases
+
+    cases = all_cases()
+    data = json.loads((path or OUT.with_suffix(".json")).read_text())
+    return [(cases[d["case"]], tuple(d["setting"]), d["rows"]) for d in data]
+
+
+def render(path=None):
+    """Rewrite :data:`OUT` from the saved runs (after a change of the verdicts or the text)."""
+    OUT.write_text(markdown(load(path), findings_of(OUT)))
 
 
 if __name__ == "__main__":
-    main(tuple(sys.argv[1:]))
+    if sys.argv[1:] == ["--render"]:
+        render()
+    else:
+        main(tuple(sys.argv[1:]))

@@ -14,7 +14,10 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
   tangent's entries in absolute value, s a size per unknown added to the state, e.g. the
   element length for displacements, so that the terms of the reference geometry count), and
   ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too, or
-  the floor is the model's own at its reference geometry: a small load on a stiff model),
+  the floor is the model's own at its reference geometry: a small load on a stiff model, or
+  the floor is the model's stiffness ratio at a state within :data:`STATE_RANGE` times the
+  reference sizes and Newton has stopped, its corrections at round-off of the state,
+  ‖du‖ ≤ :data:`ROUNDOFF_TOL`·‖|x| + s‖, and no longer decreasing: EA, GA ≫ EI/L²),
   *and* the increment criteria hold: the last correction is small against the state,
   ‖du‖ ≤ :data:`INCREMENT_TOL`·‖|x| + s‖ (or :data:`SETTLED_TOL`·‖|x| + s‖ once the
   corrections stagnate: round-off moves the state, Newton no longer does), and its
@@ -42,6 +45,14 @@ INCREMENT_TOL = 1e-10
 SETTLED_TOL = 1e-6
 #: the energy criterion at the floor (quadratic in the error: INCREMENT_TOL²)
 ENERGY_TOL = 1e-12
+#: a correction at round-off of the state: ‖du‖ ≤ ROUNDOFF_TOL·‖|x| + s‖ (Newton no longer
+#: moves the state by more than some thousand ulps)
+ROUNDOFF_TOL = 1e-12
+#: a floor above FLOOR_LIMIT·S is the model's own (its stiffness ratio) when the state raised
+#: it by at most this factor over the floor of the reference geometry (displacements within
+#: STATE_RANGE node spacings, rotations within STATE_RANGE rad); a larger factor: a state
+#: outside the model's range (the 1e12 and 1e15 N cantilevers: 1e7 and more)
+STATE_RANGE = 1e3
 
 #: PETSc's SNES reasons and what they mean here
 REASONS = {
@@ -203,7 +214,9 @@ class ScaledTest:
             self.floor = self.absolute.floor(s.A, x, s.sizes)
             self.geometry_floor = self.absolute.geometry
         record["floor"] = self.floor
-        if fnorm > FLOOR_FACTOR * self.floor or not self._resolvable(fnorm, scale):
+        if fnorm > FLOOR_FACTOR * self.floor:
+            return None
+        if not (self._resolvable(fnorm, scale) or self._settled_in_range(record, x)):
             return None
         if not self.increment_small(record, x):
             return None
@@ -219,6 +232,24 @@ class ScaledTest:
         unloaded = self.solver.force_scale == 0.0 and scale <= FLOOR_FACTOR * self.floor
         geometric = self.geometry_floor >= 0.5 * self.floor
         return fnorm <= FLOOR_LIMIT * scale or unloaded or geometric
+
+    def _settled_in_range(self, record, x):
+        """Whether a residual at the floor but above FLOOR_LIMIT·S may still be accepted: the
+        floor is the model's (its stiffness ratio: EA, GA ≫ EI/L² make eps·|K||x| exceed
+        1e-5 of the load at a moderate state), not one a huge state raised (at most
+        :data:`STATE_RANGE` times the reference geometry's), and Newton has stopped: the
+        correction is at round-off of the state (‖du‖ ≤ :data:`ROUNDOFF_TOL`·‖|x| + s‖) and
+        no longer decreases (the last three within a factor 10). The energy criterion is
+        checked after (:meth:`increment_small`). The state is then exact to round-off: its
+        residual is the round-off of the internal forces, not an error of the state."""
+        if self.floor > STATE_RANGE * self.geometry_floor:
+            return False
+        steps = [r["step"] for r in self.records[1:]][-3:]
+        if len(steps) < 3 or max(steps) > 10 * min(steps):
+            return False
+        if self.state_norm is None:
+            self.state_norm = self.measure(x)
+        return record["step"] <= ROUNDOFF_TOL * self.state_norm
 
     def linear(self, x, fnorm):
         """The test after one linear solve (``snes_type ksponly``): the residual criterion, or
