@@ -325,10 +325,15 @@ class EnergyBalance:
         self.vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         return self.vec.array_r[: self.n_owned].copy()
 
-    def reactions(self):
+    def reactions(self, residual=None):
         """Support reactions at the converged q_{n+1}: call before the state moves on (the
-        residual's rates are expressions of the state at t_n)."""
-        self.reaction = self._vector(self.residual) * self.mask if self.moving else 0.0
+        residual's rates are expressions of the state at t_n). ``residual``: F there (owned
+        entries), if the Newton solver kept it (else it is assembled)."""
+        if not self.moving:
+            self.reaction = 0.0
+            return
+        F = self._vector(self.residual) if residual is None else residual
+        self.reaction = F * self.mask
 
     def record(self, q_old, h):
         """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0)."""
@@ -519,7 +524,7 @@ def _accept(m, t, h, q_old):
     if m.dyn.extrapolation:
         m.dyn.extrapolation.accept()
     else:
-        m.balance.reactions()
+        m.balance.reactions(m.solver.residual_at_solution())
         m.dyn.accept(h)
     if m.projection:
         m.projection.apply(t, t + h)
@@ -535,6 +540,8 @@ def _march(model, s, options, prefix, log):
     solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
     solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
     balance = EnergyBalance(dyn, solver.F)
+    if balance.moving:  # the reactions of each step from Newton's last residual
+        solver.keep_residual()
     projection = Projection(dyn, balance) if s.scheme == "conserving" else None
     if s.scheme == "extrapolated":
         dyn.extrapolation = Extrapolation(dyn, solver, balance)

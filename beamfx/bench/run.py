@@ -21,7 +21,7 @@ def run_setting(case, elements, degree):
     import tempfile
 
     from ..solvers.forms import compile_seconds
-    from .profiling import jit_seconds
+    from .profiling import jit_seconds, stack_limits
     from .scenes import case_scene, run_in_process
 
     scene = case_scene(case, elements, degree)
@@ -31,6 +31,7 @@ def run_setting(case, elements, degree):
         jit = compile_seconds[0] - c0
         warm_run, warm = run_in_process(scene, folder)
     result = warm_run.result
+    model = _model_of(scene, case)
     if result.status != "converged":  # a bench setting that fails is a finding, said as such
         raise RuntimeError(f"{case.id} {elements} x P{degree}: {result.status}: {result.reason}")
     path = [
@@ -49,7 +50,8 @@ def run_setting(case, elements, degree):
         "wall_s_warm": newton_seconds(result.seconds),
         "jit_s": jit,
         "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
-        **jit_seconds(case.id, _model_of(scene, case)),
+        **jit_seconds(case.id, model),
+        **stack_limits(model),
         "values": {k: float(v) for k, v in case.measure(run.probes).items()},
         "path": [{k: float(v) for k, v in p.items()} for p in path],
     }
@@ -189,7 +191,7 @@ def _s(row, key):
 
 def _case_lines(r, figures):
     """The report section of one case: reference, table of settings, profile, orders."""
-    from .profiling import case_lines
+    from .profiling import case_lines, iteration_line
 
     lines = []
     lines += [
@@ -225,15 +227,7 @@ def _case_lines(r, figures):
     lines += case_lines(r)  # adaptive and planar-vs-full tables
     c = r["cheapest_within_tolerance"]
     if c and "warm_per_iteration_s" in c:
-        t = c["warm_per_iteration_s"]
-        split = (
-            f"Per Newton iteration at {c['elements']} x P{c['degree']} (warm, ms): "
-            f"assemble residual {1e3 * t['assemble_F']:.2f}, tangent "
-            f"{1e3 * t['assemble_J']:.2f}, LU factorisation {1e3 * t['factorise']:.2f}, "
-            f"triangular solves {1e3 * t['triangular_solve']:.2f}, Python and the rest "
-            f"{1e3 * t['python']:.2f}."
-        )
-        lines += ["", split]
+        lines += ["", iteration_line(c)]
     if r["rates"]:
         lines += [
             "",

@@ -101,24 +101,14 @@ def evaluate(model, points, cells, recover=True, full=True):
         table plus ``"axes"`` (len(cells), len(points), 3, 3), the current section axes as
         columns.
     """
-    from dolfinx import fem
-
     points = np.asarray(points, dtype=float).reshape(-1)
-    gauss = gauss_points(model.degree)
-    sample = np.concatenate([points, gauss]) if recover else points
-    key = tuple(sample.tolist())
-    per_model = _compiled.setdefault(model, {})
-    if key not in per_model:
-        expr_ufl, layout = section_expression(model)
-        X = sample.reshape(-1, 1)
-        per_model[key] = (fem.Expression(expr_ufl, X, jit_params=dict(JIT_PARAMS)), layout)
-    expr, layout = per_model[key]
+    expr, layout, key = section_evaluator(model, points, recover)
     cells = np.asarray(cells, dtype=np.int32)
     size = max(s.stop for s in layout.values())
     if len(cells):
-        values = expr.eval(cells).reshape(len(cells), len(sample), size)
+        values = expr.eval(cells).reshape(len(cells), len(key), size)
     else:
-        values = np.zeros((0, len(sample), size))
+        values = np.zeros((0, len(key), size))
     n = len(points)
     if not full:
         return {name: values[:, :n, layout[name]] for name in ("X", "u", "rot")}
@@ -131,6 +121,25 @@ def evaluate(model, points, cells, recover=True, full=True):
     R = rotation_matrices(model.kin.finite, out["rot"].reshape(-1, model.kin.output_rotation_size))
     out["axes"] = (R @ out["Lam0"].reshape(-1, 3, 3)).reshape(len(cells), n, 3, 3)
     return out
+
+
+def section_evaluator(model, points, recover=True):
+    """(compiled expression, layout, its points as a tuple) of the module table at reference
+    ``points`` (flat), followed by the Gauss points with ``recover``: compiled once per model
+    and points (collective then), afterwards a look-up. Its ``eval(cells)`` gives, per cell,
+    every point's quantities in a row of the layout's size."""
+    from dolfinx import fem
+
+    points = np.asarray(points, dtype=float).reshape(-1)
+    gauss = gauss_points(model.degree)
+    sample = np.concatenate([points, gauss]) if recover else points
+    key = tuple(sample.tolist())
+    per_model = _compiled.setdefault(model, {})
+    if key not in per_model:
+        expr_ufl, layout = section_expression(model)
+        X = sample.reshape(-1, 1)
+        per_model[key] = (fem.Expression(expr_ufl, X, jit_params=dict(JIT_PARAMS)), layout)
+    return (*per_model[key], key)
 
 
 @lru_cache

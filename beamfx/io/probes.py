@@ -9,12 +9,13 @@ on which rank) is made once per model and list of names and cached on the model:
 asks for the same probes at every step.
 """
 
+import math
 import weakref
 
 import numpy as np
 
 from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_rotation_vector
-from ._sections import cell_nodes, evaluate
+from ._sections import cell_nodes, evaluate, section_evaluator
 
 _plans = weakref.WeakKeyDictionary()  # model -> {names: (found, cells)}
 
@@ -56,6 +57,31 @@ def _plan(model, names):
         cells = np.array([c for _, (c, _) in located], dtype=np.int32)
         per_model[key] = ([(n, end) for n, (_, end) in located], cells)
     return per_model[key]
+
+
+def _kinematics(model, names, recover):
+    """{name: :func:`_kinematic_values`} of the named points this rank evaluates: the compiled
+    expression of :func:`~beamfx.io._sections.evaluate` (the same numbers) without its
+    per-call set-up; what a history asks at every step. Its plan is cached per model,
+    names and ``recover`` (the expression's points)."""
+    per_model = _plans.setdefault(model, {})
+    key = ("kinematics", tuple(names), recover)
+    if key not in per_model:
+        found, cells = _plan(model, names)
+        expr, layout, sample = section_evaluator(model, cell_nodes(model.degree), recover)
+        rows = [(n, end * model.degree) for n, end in found]  # ξ = 0 or 1
+        parts = tuple(layout[k] for k in ("X", "u", "rot"))
+        per_model[key] = (rows, cells, expr, len(sample), parts)
+    rows, cells, expr, n_sample, (X, u, rot) = per_model[key]
+    if not rows:
+        return {}
+    values = expr.eval(cells).reshape(len(rows), n_sample, -1)
+    finite = model.kin.finite
+    return {
+        n: _kinematic_values(finite, {"X": v[X], "u": v[u], "rot": v[rot]})
+        for i, (n, node) in enumerate(rows)
+        for v in (values[i, node],)
+    }
 
 
 def _point_values(finite, v):
@@ -120,13 +146,15 @@ def evaluate_points(model, names=None, recover=True, full=True):
     if unknown:
         raise ValueError(f"no named points {unknown}; the model has {sorted(model.mesh.points)}")
     model.sync()  # derived fields (the condensed model integrates its displacement)
-    found, cells = _plan(model, names)
-    values = evaluate(model, cell_nodes(model.degree), cells, recover, full)
-    point_values = _point_values if full else _kinematic_values
-    local = {}
-    for i, (n, end) in enumerate(found):
-        node = end * model.degree  # ξ = 0 or 1
-        local[n] = point_values(model.kin.finite, {k: a[i, node] for k, a in values.items()})
+    if full:
+        found, cells = _plan(model, names)
+        values = evaluate(model, cell_nodes(model.degree), cells, recover, full)
+        local = {}
+        for i, (n, end) in enumerate(found):
+            node = end * model.degree  # ξ = 0 or 1
+            local[n] = _point_values(model.kin.finite, {k: a[i, node] for k, a in values.items()})
+    else:
+        local = _kinematics(model, names, recover)
 
     result = {}
     for part in comm.allgather(local) if comm.size > 1 else [local]:
@@ -163,8 +191,8 @@ def track_rotations(previous, current):
             theta = unwrap_rotation_vector(v["quaternion"], prev)
         else:  # linear kinematics: θ is already the field
             theta = np.asarray(v["rotation_vector"], float)
-        v["rotation_vector_unwrapped"] = np.asarray(theta).tolist()
-        v["angle_unwrapped"] = float(np.linalg.norm(theta))
+        v["rotation_vector_unwrapped"] = theta.tolist()
+        v["angle_unwrapped"] = math.sqrt(theta.dot(theta))  # = np.linalg.norm, bitwise
     return current
 
 

@@ -123,14 +123,20 @@ def np_quaternion(axis, angle):
     return np.r_[np.cos(angle / 2), np.sin(angle / 2) * axis]
 
 
+def _norm(v):
+    """‖v‖₂ of a 1-D float array: what ``np.linalg.norm(v)`` computes (sqrt of ``v.dot(v)``,
+    bitwise), without its dispatch (a probe history calls it at every step)."""
+    return math.sqrt(v.dot(v))
+
+
 def axis_angle(q):
     """Axis and angle in [0, 2π] of the rotation of a quaternion of any norm.
 
     Use :func:`unwrap_rotation_vector` to follow angles beyond 2π along a load path.
     """
     q = np.asarray(q, dtype=float)
-    q = q / np.linalg.norm(q)
-    s = np.linalg.norm(q[1:])
+    q = q / _norm(q)
+    s = _norm(q[1:])
     angle = 2 * np.arctan2(s, q[0])  # in [0, 2π]
     axis = q[1:] / s if s > 1e-300 else np.array([1.0, 0.0, 0.0])
     return axis, angle
@@ -153,7 +159,7 @@ def unwrap_rotation_vector(q, previous):
     """
     axis, angle = axis_angle(q)
     prev = np.asarray(previous, dtype=float)
-    k0 = int(np.ceil(np.linalg.norm(prev) / (2 * np.pi)))
+    k0 = math.ceil(_norm(prev) / (2 * np.pi))
     # |(φ + 2πk) n - prev| is least at the integer nearest to (n·prev - φ)/2π: of the turns
     # -k0-2 .. k0+2 only that one and its neighbours are compared, in plain floats (the same
     # operations as arrays of all the turns would do, at a tenth of the cost per call)

@@ -245,7 +245,7 @@ class ArcLengthSolver:
         """R(w, λ) with zero rows on the constrained dofs (w satisfies the bcs)."""
         t = time.perf_counter()
         self.lam.value = lam
-        local = assemble_residual(self.R, self.F, self.J, self.bcs, self.w.vector, self._rows)
+        local, _ = assemble_residual(self.R, self.F, self.J, self.bcs, self.w.vector, self._rows)
         self.reactions = float(np.sqrt(self.comm.allreduce(local)))
         self.seconds["assemble_F"] += time.perf_counter() - t
         return self.R.norm()

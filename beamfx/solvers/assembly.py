@@ -4,27 +4,62 @@ solvers: Newton, arc length, load scaling)."""
 import numpy as np
 
 
-def assemble_residual(b, F, J, bcs, x, rows=None):
+def assemble_residual(b, F, J, bcs, x, rows=None, keep=None):
     """Residual b = F with lifting of ``bcs`` about ``x``, b = x - g on constrained rows (b zeroed).
 
     The Newton correction then drives the constrained dofs to their prescribed values g.
     ``rows``: owned local rows (the constrained ones) whose assembled F (the reactions) is
     measured before it is replaced; returns the local sum of their squares (0 without).
+    The lifting is skipped where ``x`` already holds every prescribed value (:func:`lifts`):
+    each of its terms is then an exact zero. ``keep``: an array of the owned size that
+    receives F before the conditions replace its constrained rows (with the lifting if
+    there was one; the return value then says so).
+
+    Returns:
+        (local sum of squares of F on ``rows``, whether the lifting was applied).
     """
     import dolfinx.fem.petsc as fp
     from petsc4py import PETSc
 
+    lift = lifts(bcs, x, rows)
     with b.localForm() as local:
         local.set(0.0)
     fp.assemble_vector(b, F)
-    fp.apply_lifting(b, [J], bcs=[bcs], x0=[x], scale=-1.0)
+    if lift:
+        fp.apply_lifting(b, [J], bcs=[bcs], x0=[x], scale=-1.0)
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    if keep is not None:
+        keep[:] = b.getArray(readonly=True)
     local = 0.0
     if rows is not None and len(rows):
         with np.errstate(over="ignore"):  # a diverging iterate: inf, the test says NaN/diverged
             local = float(np.sum(b.getArray(readonly=True)[rows] ** 2))
     fp.set_bc(b, bcs, x, -1.0)
-    return local
+    return local, lift
+
+
+def lifts(bcs, x, rows):
+    """Whether the lifting of ``bcs`` about ``x`` can be nonzero: some constrained dof of
+    ``x`` differs from its prescribed value g (or is not finite) on some rank. Each term of
+    the lifting is A_ij (g_j - x_j), an exact zero where x_j = g_j: a time step or a load
+    step that starts from the prescribed values, and every Newton iterate after the first,
+    need none. ``rows``: the owned constrained rows (None: always lift). Collective."""
+    import dolfinx.cpp.fem
+
+    if not bcs or rows is None:
+        return bool(bcs)
+    owned = x.getArray(readonly=True)
+    gap = np.empty(len(owned))  # only the constrained rows are written, and read
+    dolfinx.cpp.fem.set_bc(gap, bcs, owned, -1.0)  # x - g on the owned constrained rows
+    local = bool(np.any(gap[rows] != 0.0))  # NaN != 0: lift (the old path, NaN and all)
+    comm = x.getComm()
+    return local if comm.getSize() == 1 else bool(comm.tompi4py().allreduce(local, op=_max()))
+
+
+def _max():
+    from mpi4py import MPI
+
+    return MPI.MAX
 
 
 def assemble_tangent(A, J, bcs):

@@ -124,13 +124,23 @@ class AbsoluteTangent:
     def __init__(self, A):
         self.B = A.duplicate(copy=False)
         self.v, self.out = A.createVecs()
+        self._pattern = None  # (row pointers, columns) of B
 
     def floor(self, A, x, sizes):
         """ε‖ |A| (|x| + sizes) ‖₂ (``sizes``: local owned array or None). Collective."""
-        # a copy of the tangent: its pattern may have grown (a coupling's entries added)
-        self.B.destroy()
-        self.B = A.duplicate(copy=True)
-        rows, cols, vals = self.B.getValuesCSR()
+        rows, cols, vals = A.getValuesCSR()
+        same = self._pattern is not None and all(
+            np.array_equal(a, b) for a, b in zip(self._pattern, (rows, cols), strict=True)
+        )
+        comm = A.getComm()
+        if comm.getSize() > 1:  # the copy is collective: every rank or none
+            from mpi4py import MPI
+
+            same = comm.tompi4py().allreduce(same, op=MPI.LAND)
+        if not same:  # a new copy: the pattern may have grown (a coupling's entries added)
+            self.B.destroy()
+            self.B = A.duplicate(copy=True)
+            self._pattern = (rows, cols)
         self.B.setValuesCSR(rows, cols, np.abs(vals))
         self.B.assemble()
         eps = np.finfo(float).eps

@@ -33,14 +33,19 @@ LINEAR_EVENTS = {
 }
 
 
+_events = {}  # LINEAR_EVENTS' keys -> their PETSc log events, looked up once
+
+
 def linear_solve_seconds():
     """Seconds spent so far in the :data:`LINEAR_EVENTS` (PETSc logging, started here)."""
-    from petsc4py import PETSc
+    if not _events:
+        from petsc4py import PETSc
 
-    PETSc.Log.begin()  # idempotent; the cost is a few counters per event
+        PETSc.Log.begin()  # the cost is a few counters per event
+        for key, names in LINEAR_EVENTS.items():
+            _events[key] = [PETSc.Log.Event(name) for name in names]
     return {
-        key: sum(PETSc.Log.Event(name).getPerfInfo()["time"] for name in names)
-        for key, names in LINEAR_EVENTS.items()
+        key: sum(e.getPerfInfo()["time"] for e in events) for key, events in _events.items()
     }
 
 
@@ -107,6 +112,8 @@ class NewtonSolver:
         self.rtol = float(self.options.get("snes_rtol", 0.0))
         self.force_scale, self.reactions, self.sizes = 0.0, 0.0, None
         self._rows = constrained_rows(bcs, self.b.getLocalSize())
+        self.comm = w.function_space.mesh.comm
+        self._kept = None  # (x, F before the conditions, lifted) of the last residual
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
@@ -129,8 +136,14 @@ class NewtonSolver:
         self.w.x.scatter_forward()
         if self.coupling:
             self.coupling.update()
-        local = assemble_residual(b, self.F, self.J, self.bcs, x, rows=self._rows)
-        self.reactions = float(np.sqrt(self.w.function_space.mesh.comm.allreduce(local)))
+        kept = self._kept
+        keep = kept[1] if kept else None
+        local, lifted = assemble_residual(b, self.F, self.J, self.bcs, x, self._rows, keep)
+        if kept:
+            kept[0][:] = x.getArray(readonly=True)
+            kept[2] = lifted
+        comm = self.comm
+        self.reactions = float(np.sqrt(comm.allreduce(local) if comm.size > 1 else local))
         self.seconds["assemble_F"] += time.perf_counter() - t
 
     def _jacobian(self, snes, x, A, P):
@@ -160,6 +173,21 @@ class NewtonSolver:
         the reference state: e.g. the element length for a displacement, 1 for a rotation)."""
         self.sizes = None if sizes is None else np.asarray(sizes, float)
 
+    def keep_residual(self):
+        """Keep a copy of F (before the conditions replace its constrained rows) at every
+        residual evaluation, for :meth:`residual_at_solution`."""
+        n = self.b.getLocalSize()
+        self._kept = [np.empty(n), np.empty(n), True]
+
+    def residual_at_solution(self):
+        """F at the last solution (owned entries, the constrained rows as assembled: the
+        reactions), bitwise as an assembly of F there would give; None if it was not kept
+        (:meth:`keep_residual`), was evaluated elsewhere or included a lifting."""
+        kept = self._kept
+        if kept is None or kept[2] or not np.array_equal(kept[0], self.x.getArray(readonly=True)):
+            return None
+        return kept[1]
+
     def solve(self):
         """Run Newton from the current ``w``; ``w`` holds the last iterate. Returns a report."""
         from petsc4py import PETSc
@@ -178,7 +206,7 @@ class NewtonSolver:
             # ksponly (one linear solve) stops without asking the test: ask it here
             self.test.linear(self.x, self._residuals[-1])
         seconds = self._split(before, linear_before, time.perf_counter() - t)
-        reason = reason_names().get(code, str(code))
+        reason = _reason_name(code)
         done = (reason, self.snes.getIterationNumber(), tuple(self._residuals), seconds)
         if code > 0 and self.test.how is not None:
             scale = self.test.records[-1]["scale"]
@@ -209,6 +237,16 @@ class NewtonSolver:
         self.A.destroy()
         self.b.destroy()
         self.x.destroy()
+
+
+_reasons = {}
+
+
+def _reason_name(code):
+    """PETSc's name of a SNES reason ``code`` (the table built once)."""
+    if not _reasons:
+        _reasons.update(reason_names())
+    return _reasons.get(code, str(code))
 
 
 def constrained_rows(bcs, n_owned):
