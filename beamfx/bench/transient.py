@@ -128,8 +128,8 @@ class TransientCase(Case):
         the warm run's solve-only time (and the ``scheme`` if the setting names one)."""
         import tempfile
 
-        from ..solvers.forms import compile_seconds
         from ..analyses.model import BeamModel
+        from ..solvers.forms import compile_seconds
         from .profiling import newton_seconds, per_iteration, stack_limits
         from .scenes import run_in_process
 

@@ -44,9 +44,7 @@ def linear_solve_seconds():
         PETSc.Log.begin()  # the cost is a few counters per event
         for key, names in LINEAR_EVENTS.items():
             _events[key] = [PETSc.Log.Event(name) for name in names]
-    return {
-        key: sum(e.getPerfInfo()["time"] for e in events) for key, events in _events.items()
-    }
+    return {key: sum(e.getPerfInfo()["time"] for e in events) for key, events in _events.items()}
 
 
 class SolveReport(NamedTuple):
