@@ -4,7 +4,7 @@ solvers: Newton, arc length, load scaling)."""
 import numpy as np
 
 
-def assemble_residual(b, F, J, bcs, x, rows=None, keep=None):
+def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None):
     """Residual b = F with lifting of ``bcs`` about ``x``, b = x - g on constrained rows (b zeroed).
 
     The Newton correction then drives the constrained dofs to their prescribed values g.
@@ -13,7 +13,8 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None):
     The lifting is skipped where ``x`` already holds every prescribed value (:func:`lifts`):
     each of its terms is then an exact zero. ``keep``: an array of the owned size that
     receives F before the conditions replace its constrained rows (with the lifting if
-    there was one; the return value then says so).
+    there was one; the return value then says so). ``targets``: the prescribed values on
+    ``rows`` (:func:`prescribed`), if the caller knows them.
 
     Returns:
         (local sum of squares of F on ``rows``, whether the lifting was applied).
@@ -21,7 +22,7 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None):
     import dolfinx.fem.petsc as fp
     from petsc4py import PETSc
 
-    lift = lifts(bcs, x, rows)
+    lift = lifts(bcs, x, rows, targets)
     with b.localForm() as local:
         local.set(0.0)
     fp.assemble_vector(b, F)
@@ -38,28 +39,33 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None):
     return local, lift
 
 
-def lifts(bcs, x, rows):
+def lifts(bcs, x, rows, targets=None):
     """Whether the lifting of ``bcs`` about ``x`` can be nonzero: some constrained dof of
     ``x`` differs from its prescribed value g (or is not finite) on some rank. Each term of
     the lifting is A_ij (g_j - x_j), an exact zero where x_j = g_j: a time step or a load
     step that starts from the prescribed values, and every Newton iterate after the first,
-    need none. ``rows``: the owned constrained rows (None: always lift). Collective."""
-    import dolfinx.cpp.fem
-
+    need none. ``rows``: the owned constrained rows (None: always lift); ``targets``: g on
+    them (:func:`prescribed`), if known. Collective."""
     if not bcs or rows is None:
         return bool(bcs)
-    owned = x.getArray(readonly=True)
-    gap = np.empty(len(owned))  # only the constrained rows are written, and read
-    dolfinx.cpp.fem.set_bc(gap, bcs, owned, -1.0)  # x - g on the owned constrained rows
-    local = bool(np.any(gap[rows] != 0.0))  # NaN != 0: lift (the old path, NaN and all)
+    if targets is None:
+        targets = prescribed(bcs, rows, x.getLocalSize())
+    local = bool((x.getArray(readonly=True)[rows] != targets).any())  # NaN: lift
     comm = x.getComm()
-    return local if comm.getSize() == 1 else bool(comm.tompi4py().allreduce(local, op=_max()))
-
-
-def _max():
+    if comm.getSize() == 1:
+        return local
     from mpi4py import MPI
 
-    return MPI.MAX
+    return bool(comm.tompi4py().allreduce(local, op=MPI.LOR))
+
+
+def prescribed(bcs, rows, n_owned):
+    """The prescribed values g of ``bcs`` on the owned constrained ``rows`` (local)."""
+    from dolfinx.cpp.fem import set_bc
+
+    g = np.empty(n_owned)  # only the constrained rows are written, and read
+    set_bc(g, bcs, None, 1.0)
+    return g[rows]
 
 
 def assemble_tangent(A, J, bcs):

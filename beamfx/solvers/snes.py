@@ -5,7 +5,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .assembly import assemble_residual, assemble_tangent
+from .assembly import assemble_residual, assemble_tangent, prescribed
 from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
 from .options import petsc_options
@@ -112,6 +112,7 @@ class NewtonSolver:
         self._rows = constrained_rows(bcs, self.b.getLocalSize())
         self.comm = w.function_space.mesh.comm
         self._kept = None  # (x, F before the conditions, lifted) of the last residual
+        self._targets = None  # the prescribed values on the constrained rows, per solve
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
@@ -136,7 +137,9 @@ class NewtonSolver:
             self.coupling.update()
         kept = self._kept
         keep = kept[1] if kept else None
-        local, lifted = assemble_residual(b, self.F, self.J, self.bcs, x, self._rows, keep)
+        local, lifted = assemble_residual(
+            b, self.F, self.J, self.bcs, x, self._rows, keep, self._targets
+        )
         if kept:
             kept[0][:] = x.getArray(readonly=True)
             kept[2] = lifted
@@ -192,6 +195,8 @@ class NewtonSolver:
 
         self._residuals = []
         self.test.reset()
+        # the prescribed values, fixed during the solve (whether a residual needs a lifting)
+        self._targets = prescribed(self.bcs, self._rows, self.b.getLocalSize())
         before = dict(self.seconds)
         linear_before = linear_solve_seconds()
         t = time.perf_counter()
