@@ -150,11 +150,13 @@ class ReactionRecovery:
         held = np.zeros(n, bool)
         held[constrained_dofs(model.bcs)] = True
         self.points = {}  # at -> (Dirichlet mask, spring mask)
+        self.dofs = {}  # at -> its dofs (located once: 2 ms a call on 16 cells)
         spring_points = [s.at for s in model.spec.springs]
         spring_points += [s.at for s in model.spec.supports if s.axes == "local"]
         for at in dict.fromkeys([s.at for s in model.spec.supports] + spring_points):
             at_point = np.zeros(n, bool)
-            at_point[_vertex_dofs(model, at)] = True
+            self.dofs[at] = _vertex_dofs(model, at)
+            at_point[self.dofs[at]] = True
             ground = at_point if at in spring_points else np.zeros(n, bool)
             self.points[at] = (at_point & held, ground)
 
@@ -194,7 +196,7 @@ class ReactionRecovery:
                 f2, m2, _, _ = resultant(model, layout, spring, ground)
                 force, moment = force + f2, moment + m2
             total += np.r_[force, moment]
-            x = _point_position(model, layout, at)
+            x = _point_position(model, layout, self.dofs[at])
             out[at] = Reaction(force.tolist(), (moment - np.cross(x, force)).tolist(), x.tolist())
         load = self.applied()
         force, moment, f_scale, m_scale = resultant(model, layout, load, np.ones(len(load), bool))
@@ -207,9 +209,9 @@ class ReactionRecovery:
         return out, balance
 
 
-def _point_position(model, layout, at):
-    """Position of the named point ``at`` (current for finite kinematics). Collective."""
-    dofs = _vertex_dofs(model, at)
+def _point_position(model, layout, dofs):
+    """Position of the named point whose dofs are ``dofs`` (:func:`_vertex_dofs`; current for
+    finite kinematics). Collective."""
     rows = np.flatnonzero(np.isin(layout.u[:, 0], dofs))[:1]
     x = np.array(layout.X[rows])
     if model.kin.finite:
