@@ -130,7 +130,8 @@ class AbsoluteTangent:
         """ε‖ |A| (|x| + sizes) ‖₂ (``sizes``: local owned array or None). Collective."""
         rows, cols, vals = A.getValuesCSR()
         same = self._pattern is not None and all(
-            np.array_equal(a, b) for a, b in zip(self._pattern, (rows, cols), strict=True)
+            a.shape == b.shape and (a == b).all()
+            for a, b in zip(self._pattern, (rows, cols), strict=True)
         )
         comm = A.getComm()
         if comm.getSize() > 1:  # the copy is collective: every rank or none
@@ -181,7 +182,7 @@ class ScaledTest:
         """PETSc's reason after iteration ``it`` (norms: ‖x‖, ‖du‖, ‖F‖); ITERATING to go on."""
         from petsc4py import PETSc
 
-        F = snes.getFunction()[0]
+        F = self.solver.b  # the SNES's residual vector (getFunction() costs a tuple a call)
         du = snes.getSolutionUpdate() if it > 0 else None
         how = self.check(it, norms, F, du, snes.getSolution())
         return getattr(PETSc.SNES.ConvergedReason, CODES[how])

@@ -185,7 +185,7 @@ class NewtonSolver:
         reactions), bitwise as an assembly of F there would give; None if it was not kept
         (:meth:`keep_residual`), was evaluated elsewhere or included a lifting."""
         kept = self._kept
-        if kept is None or kept[2] or not np.array_equal(kept[0], self.x.getArray(readonly=True)):
+        if kept is None or kept[2] or not (kept[0] == self.x.getArray(readonly=True)).all():
             return None
         return kept[1]
 
