@@ -108,7 +108,7 @@ def _kinematic_values(finite, v):
     X, u, rot = v["X"], v["u"], v["rot"]
     out = {"position": (X + u).tolist(), "displacement": u.tolist()}
     if finite:
-        out["quaternion"] = (rot / np.linalg.norm(rot)).tolist()
+        out["quaternion"] = (rot / math.sqrt(rot.dot(rot))).tolist()  # np.linalg.norm, bitwise
     else:
         out["rotation_vector"] = rot.tolist()
     return out
