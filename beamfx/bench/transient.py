@@ -153,7 +153,7 @@ class TransientCase(Case):
             "wall_s_warm": newton_seconds(result.seconds),
             "jit_s": jit,
             "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
-            **stack_limits(BeamModel(scene.model), self.build(elements, degree, dt)[1]),
+            **stack_limits(BeamModel(scene.model), self.build(elements, degree, dt, *scheme)[1]),
             "values": {k: float(v) for k, v in self.measure(history, scene.model).items()},
             "history": _thinned((self.series or tip_series)(history)),
         } | ({"scheme": scheme[0]} if scheme else {})
