@@ -187,9 +187,10 @@ def test_documented_scene_runs_the_same_on_all_ranks(analysis):
     for key in ("frequencies_hz", "load_factors"):
         if key in serial:
             assert np.allclose(parallel[key], serial[key], rtol=1e-8), key
-    if "path" in serial:
-        a = np.array([p["load_factor"] for p in parallel["path"]])
-        b = np.array([p["load_factor"] for p in serial["path"]])
+    if "path" in serial:  # load factors (or a rotating run's speeds) and the probes along it
+        key = "speed_rad_s" if serial["analysis"] == "rotating" else "load_factor"
+        a = np.array([p[key] for p in parallel["path"]])
+        b = np.array([p[key] for p in serial["path"]])
         assert a.shape == b.shape and np.allclose(a, b, rtol=1e-8, atol=1e-10)
     for name, probe in serial["probes"].items():
         for what in ("position", "rotation_vector"):
