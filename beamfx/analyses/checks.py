@@ -48,15 +48,29 @@ def end_contacts(model, rtol=1e-8):
     """(i, j, s): the end of beam i lies on beam j at its arc length s (to rtol of the model)."""
     tol = rtol * model_size(model)
     lo, hi = _boxes(model, tol)
+    ends = [a.curve.points([0.0, a.curve.length]) for a in model.beams]
+    boxes = _box_search(lo, hi, np.vstack(ends))
     out = []
     for i, a in enumerate(model.beams):
-        for x in a.curve.points([0.0, a.curve.length]):
-            near = np.flatnonzero(np.all((lo <= x) & (x <= hi), axis=1))  # boxes holding x
+        for e, x in enumerate(ends[i]):
+            near = boxes[2 * i + e]
+            near = near[np.all((lo[near] <= x) & (x <= hi[near]), axis=1)]  # boxes holding x
             for j in near[near != i]:
                 s, dist = closest_arc_length(model.beams[j].curve, x)
                 if dist < tol:
                     out.append((i, int(j), s))
     return out
+
+
+def _box_search(lo, hi, points):
+    """Per point, the sorted indices of the boxes whose centre is within the largest box
+    half-diagonal of it (a superset of the boxes holding it): a k-d tree, so that a frame of
+    10⁵ members is not checked pairwise."""
+    from scipy.spatial import cKDTree
+
+    centre, radius = (lo + hi) / 2, float(np.max(np.linalg.norm(hi - lo, axis=1))) / 2
+    found = cKDTree(centre).query_ball_point(points, radius * (1 + 1e-12))
+    return [np.array(sorted(f), dtype=np.int64) for f in found]
 
 
 def _boxes(model, tol, samples=64):
@@ -89,6 +103,7 @@ def connected_beams(model, rtol=1e-8):
 
     def root(i):
         while group[i] != i:
+            group[i] = group[group[i]]  # path halving: near-flat trees on large frames
             i = group[i]
         return i
 

@@ -6,6 +6,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..solvers import NewtonSolver, SolveFailed, step_load
+from ..solvers.options import is_iterative
 from ..solvers.stepping import SavedState
 
 
@@ -118,7 +119,8 @@ def solve_static(
 
     n = 1 if not model.kin.finite else steps
     before = dict(solver.seconds)
-    counts, counted = [], _inertia_counter(model, inertia)
+    # an LDLᵀ factorisation per step is what the iterative solver avoids
+    counts, counted = [], _inertia_counter(model, inertia and not is_iterative(solver.options))
 
     def accepted(step):
         if counted is not None:  # the tangent at the converged state, assembled once more

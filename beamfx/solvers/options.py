@@ -45,15 +45,54 @@ TERMINAL = (
 _WORD = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
 
 
+#: ``linear`` in ``[solver]``: the linear solver of every Newton iteration, as a preset of
+#: PETSc options (options given beside it win). ``direct``: LU by MUMPS (the default).
+#: ``iterative``: conjugate gradients preconditioned by smoothed-aggregation algebraic
+#: multigrid (GAMG); for a symmetric tangent (dead loads). Why these, and what they cost:
+#: docs/scenes.md ("[solver]") and docs/validation/frame_scaling.md
+LINEAR = {
+    "direct": {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
+    "iterative": {
+        "ksp_type": "cg",
+        "ksp_rtol": 1e-10,
+        "ksp_max_it": 5000,
+        "pc_type": "gamg",
+        "pc_gamg_type": "agg",
+    },
+}
+
+
+def expand_linear(options):
+    """``options`` with the ``linear`` preset (:data:`LINEAR`) written out; the options given
+    beside it win. Raises ValueError for an unknown preset."""
+    options = dict(options or {})
+    preset = options.pop("linear", None)
+    if preset is None:
+        return options
+    if preset not in LINEAR:
+        raise ValueError(f"linear = {preset!r}: allowed: {', '.join(map(repr, LINEAR))}")
+    return {**LINEAR[preset], **options}
+
+
+def is_iterative(options):
+    """Whether PETSc ``options`` (expanded) solve with a Krylov method, not a factorisation."""
+    return options.get("ksp_type", "preonly") != "preonly"
+
+
 def _allowed(name):
     return name in ALLOWED or re.sub(r"_\d{1,4}$", "_<n>", name) in ALLOWED
 
 
 def option_problems(options):
     """(option, message) of every ``[solver]`` option a scene may not set: names off
-    :data:`ALLOWED` and :data:`TERMINAL`, a value on a terminal option (it would name a
-    viewer, e.g. a file), values that are not a number, true/false or a plain word."""
+    :data:`ALLOWED` and :data:`TERMINAL`, a ``linear`` preset not in :data:`LINEAR`, a value
+    on a terminal option (it would name a viewer, e.g. a file), values that are not a number,
+    true/false or a plain word."""
     for key, value in options.items():
+        if key == "linear":
+            if value not in LINEAR:
+                yield key, f"{value!r}: allowed: {', '.join(map(repr, LINEAR))}"
+            continue
         if key in TERMINAL:
             if value != "":
                 yield key, f'prints to the terminal only: give it as "", not {value!r}'

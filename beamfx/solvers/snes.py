@@ -8,7 +8,7 @@ import numpy as np
 from .assembly import assemble_residual, assemble_tangent, prescribed
 from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
-from .options import petsc_options
+from .options import expand_linear, petsc_options
 
 #: defaults chosen for beams (notes §4): full Newton steps (the bt line search stalls on the
 #: stiff axial term), no divergence stop, LU with MUMPS. The convergence test is beamfx's
@@ -105,7 +105,7 @@ class NewtonSolver:
         self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0, "test": 0.0}
         linear_solve_seconds()  # start PETSc's event log before the first solve
         self._residuals = []
-        self.options = {**DEFAULT_OPTIONS, **(options or {})}
+        self.options = {**DEFAULT_OPTIONS, **expand_linear(options)}
         self.atol = float(self.options.get("snes_atol", 0.0))
         self.rtol = float(self.options.get("snes_rtol", 0.0))
         self.force_scale, self.reactions, self.sizes = 0.0, 0.0, None
