@@ -9,7 +9,7 @@ export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export PYTHONUNBUFFERED := 1
 
-.PHONY: install run test test-slow bench bench-peers bench-solid-scaling lint clean
+.PHONY: install run test test-slow bench bench-peers bench-solid-scaling bench-frame-scaling lint clean
 
 install:
 	bash scripts/install.sh
@@ -36,6 +36,16 @@ bench-solid-scaling: install
 	$(PY) -m beamfx.bench.solid_scaling run docs/validation
 	$(MPIRUN) $(PY) -m beamfx.bench.solid_scaling run docs/validation
 	$(PY) -m beamfx.bench.solid_scaling report docs/validation
+
+# BCC lattice frames of 10³ to 10⁶ unknowns on 1 and 2 ranks, MUMPS and CG + GAMG (long: the
+# 10⁶ size alone takes tens of minutes and several GiB; not part of `make test`)
+FRAME_CELLS := 2 5 10
+bench-frame-scaling: install
+	$(PY) -m beamfx.bench.frame_scaling run docs/validation $(FRAME_CELLS)
+	$(MPIRUN) $(PY) -m beamfx.bench.frame_scaling run docs/validation $(FRAME_CELLS)
+	$(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative
+	$(MPIRUN) $(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative
+	$(PY) -m beamfx.bench.frame_scaling report docs/validation
 
 # beamfx beside Exudyn, PyElastica, CalculiX, OpenSeesPy and pyBModes (peer venv PEERS_VENV,
 # default .venv-peers; not part of `make test`); report in docs/validation/peers*.md

@@ -54,7 +54,7 @@ LINEAR = {
     "direct": {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
     "iterative": {
         "ksp_type": "cg",
-        "ksp_rtol": 1e-10,
+        "ksp_rtol": 1e-12,
         "ksp_max_it": 5000,
         "pc_type": "gamg",
         "pc_gamg_type": "agg",
