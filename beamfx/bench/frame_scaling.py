@@ -149,6 +149,7 @@ def measure(folder, cells, kinematics, linear, comm):
     split["other"] = max(0.0, seconds["solve"] - sum(split.values()))
     at = scene.probes["corner"]
     probe = evaluate_points(model, [at], full=False)[at]
+    seconds["output"] = _write_frame(folder / f"out_{comm.size}", scene, model, comm)
     reactions = entries(model)
     out = {
         "cells": cells,
@@ -172,6 +173,23 @@ def measure(folder, cells, kinematics, linear, comm):
     return out
 
 
+def _write_frame(out, scene, model, comm):
+    """Seconds (slowest rank) to write the state as a ParaView frame, as ``beamfx run`` does:
+    each rank its own piece, nothing gathered."""
+    from dataclasses import replace
+
+    from ..io.output import FrameWriter
+
+    if comm.rank == 0:
+        out.mkdir(parents=True, exist_ok=True)
+    comm.barrier()
+    t = time.perf_counter()
+    frames = FrameWriter(out, model, replace(scene.output, dir=str(out)), scene.model.beams, comm)
+    frames.write(1, 1.0)
+    frames.close()
+    return comm.allreduce(time.perf_counter() - t, op=_max())
+
+
 def _total_force(reactions):
     """The sum of the reaction forces (it balances the 1 N per top node)."""
     return [float(sum(r["force"][i] for r in reactions.values())) for i in range(3)]
@@ -185,6 +203,9 @@ def run(cells=CELLS, linear=("direct", "iterative"), comm=None):
 
     from mpi4py import MPI
 
+    from ..io.vtkfiles import import_vtk
+
+    import_vtk()  # before DOLFINx (docs: the VTK wheel and DOLFINx's RTLD_GLOBAL)
     comm = comm or MPI.COMM_WORLD
     folder = Path(comm.bcast(tempfile.mkdtemp() if comm.rank == 0 else None))
     out = []

@@ -36,9 +36,9 @@ def _table(runs):
         (
             "| cells | kinematics | linear solver | ranks | unknowns | Newton its | Krylov its "
             "| per Newton iteration s: assembly + PC set-up + solve + other = total "
-            "| µs per unknown and iteration (× ranks) | peak MiB per rank |"
+            "| µs per unknown and iteration (× ranks) | peak MiB per rank | model s | frame s |"
         ),
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for key in sorted(runs):
         r = runs[key]
@@ -48,7 +48,9 @@ def _table(runs):
             f"| {r['cells']}³ | {r['kinematics']} | {r['linear']} | {r['ranks']} "
             f"| {r['unknowns']:,} | {r['newton_iterations']} | {r['krylov_iterations']} "
             f"| {split} = {per_iteration(r):.3g} | {us_per_unknown(r):.1f} "
-            f"| {' / '.join(f'{m:.0f}' for m in r['peak_MiB'])} |"
+            f"| {' / '.join(f'{m:.0f}' for m in r['peak_MiB'])} "
+            f"| {r['seconds']['scene'] + r['seconds']['model']:.3g} "
+            f"| {r['seconds'].get('output', float('nan')):.3g} |"
         )
     return lines
 
@@ -75,8 +77,8 @@ def _rel(a, b):
 def project(one, two, ranks):
     """(low, high) seconds per Newton iteration on ``ranks`` ranks from the 1- and 2-rank
     runs of one case: each phase keeps the efficiency e = t1 / (2 t2) (clipped to [1/2, 1])
-    measured from 1 to 2 ranks for every further doubling, t(p) = t2 (1 / 2e)^log2(p / 2); the solve
-    phase scales per Krylov iteration, with the iterations at the 2-rank count (low) or
+    measured from 1 to 2 ranks for every further doubling, t(p) = t2 (1 / 2e)^log2(p / 2);
+    the solve phase scales per Krylov iteration, with the iterations at the 2-rank count (low) or
     growing by the measured 1-to-2-rank factor per doubling (high)."""
     d = math.log2(ranks / 2)
     a, b = one["per_newton_iteration"], two["per_newton_iteration"]
@@ -160,8 +162,9 @@ Times per Newton iteration are the slowest rank's PETSc events: assembly (residu
 tangent), PC set-up (MUMPS: the factorisation; GAMG: the hierarchy), solve (MUMPS: the
 triangular solves; CG: its iterations) and other (Newton's test, the step bookkeeping).
 Peak memory is each solve's resident high-water mark per rank (model, forms, matrices,
-factor or hierarchy; about 120 MiB of it are the libraries). Not timed here: building the
-model (in `seconds` of the .json) and writing output.
+factor or hierarchy; about 120 MiB of it are the libraries). Outside the Newton iterations:
+building the model and writing one ParaView frame (each rank its own piece, nothing
+gathered), in the last columns.
 
 **Noise.** Measured while 8 jobs shared the 2 cores of this machine: every time is
 inflated and noisy (±30 % and more; the 2-rank runs suffer most, since their ranks wait for
