@@ -98,7 +98,12 @@ def _event_seconds():
 
 def _peak_mib(comm, reset=False):
     """Peak resident memory (VmHWM) of every rank in MiB; ``reset`` starts a new peak."""
-    if reset:
+    if reset:  # freed heap back to the system first, else the last solve's stays counted
+        import ctypes
+        import gc
+
+        gc.collect()
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
         Path("/proc/self/clear_refs").write_text("5")
     status = Path("/proc/self/status").read_text().splitlines()
     kib = next(int(x.split()[1]) for x in status if x.startswith("VmHWM"))
