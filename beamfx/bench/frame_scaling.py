@@ -200,9 +200,9 @@ def _total_force(reactions):
     return [float(sum(r["force"][i] for r in reactions.values())) for i in range(3)]
 
 
-def run(cells=CELLS, linear=("direct", "iterative"), comm=None):
+def run(cells=CELLS, linear=("direct", "iterative"), comm=None, save=None):
     """Every size, kinematics and linear solver on ``comm``'s ranks (a list of dicts); the
-    meshes go to a temporary folder."""
+    meshes go to a temporary folder. ``save(runs)`` is called on rank 0 after each solve."""
     import shutil
     import tempfile
 
@@ -221,6 +221,8 @@ def run(cells=CELLS, linear=("direct", "iterative"), comm=None):
                     out.append(measure(folder, n, kinematics, solver, comm))
                     if comm.rank == 0:
                         print(json.dumps(_brief(out[-1])), flush=True)
+                        if save:
+                            save(out)
     finally:
         comm.barrier()
         if comm.rank == 0:
@@ -257,14 +259,16 @@ def main(argv=None):
         report(args.folder)
         return
     comm = MPI.COMM_WORLD
-    runs = run(tuple(args.cells), tuple(args.linear or ("direct", "iterative")), comm)
-    if comm.rank == 0:
-        out = args.folder / f"frame_scaling_np{comm.size}.json"
-        old = json.loads(out.read_text())["runs"] if out.exists() else []
+    out = args.folder / f"frame_scaling_np{comm.size}.json"
+    old = json.loads(out.read_text())["runs"] if comm.rank == 0 and out.exists() else []
+
+    def save(runs):  # after every solve: a long run stopped keeps what it measured
         new = {(r["cells"], r["kinematics"], r["linear"]) for r in runs}
         keep = [r for r in old if (r["cells"], r["kinematics"], r["linear"]) not in new]
         args.folder.mkdir(parents=True, exist_ok=True)
         out.write_text(json.dumps({"runs": keep + runs}, indent=1, default=float))
+
+    run(tuple(args.cells), tuple(args.linear or ("direct", "iterative")), comm, save)
 
 
 if __name__ == "__main__":
