@@ -173,8 +173,11 @@ def _direct_line(runs, kin, a, b):
     if other:
         extra = max(b["peak_MiB"]) - max(other["peak_MiB"])
         line += (
-            f"; its factor takes about {extra:.0f} MiB more than the iterative run's peak "
-            f"there, {extra * big ** (4 / 3) / 1024:.1f} GiB at 10⁶ by the N^(4/3) law"
+            f"; its peak memory is {extra:.0f} MiB above the iterative run's there, "
+            f"{extra * big ** (4 / 3) / 1024:.1f} GiB at 10⁶ by the N^(4/3) law"
+            if extra > 0
+            else f"; its peak memory is no higher than the iterative run's there ({extra:.0f} "
+            "MiB): the model, the forms and the output frame outweigh the factor at this size"
         )
     return line + ". So 10⁶ unknowns are solved iteratively only."
 
