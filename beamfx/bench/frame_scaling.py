@@ -124,7 +124,9 @@ def _solve(scene, comm):
     )
     seconds["forms"] = time.perf_counter() - t - seconds["model"]
     events = _event_seconds()
+    _peak_mib(comm, reset=True)
     solved = solve_static(model, steps=1, options=scene.solver_options, solver=solver)
+    seconds["peak_MiB_solve"] = _peak_mib(comm)
     after = _event_seconds()
     seconds["solve"] = solved.seconds["total"]
     split = {k: comm.allreduce(after[k] - events[k], op=_max()) for k in EVENTS}
@@ -169,7 +171,8 @@ def measure(folder, cells, kinematics, linear, comm):
         "seconds": {"scene": read, **seconds},
         "seconds_in_solve": split,
         "per_newton_iteration": {k: v / newton for k, v in split.items()},
-        "peak_MiB": _peak_mib(comm),
+        "peak_MiB": _peak_mib(comm),  # the whole case: model, solve, frame
+        "peak_MiB_solve": seconds.pop("peak_MiB_solve"),  # the Newton iterations only
         "probe_displacement": [float(v) for v in probe["displacement"]],
         "reaction_force": _total_force(reactions["reactions"]),
         "reactions": {k: v["force"] for k, v in list(reactions["reactions"].items())[:4]},
@@ -260,13 +263,15 @@ def main(argv=None):
         return
     comm = MPI.COMM_WORLD
     out = args.folder / f"frame_scaling_np{comm.size}.json"
-    old = json.loads(out.read_text())["runs"] if comm.rank == 0 and out.exists() else []
+    before = json.loads(out.read_text()) if comm.rank == 0 and out.exists() else {}
+    old = before.get("runs", [])
 
     def save(runs):  # after every solve: a long run stopped keeps what it measured
         new = {(r["cells"], r["kinematics"], r["linear"]) for r in runs}
         keep = [r for r in old if (r["cells"], r["kinematics"], r["linear"]) not in new]
         args.folder.mkdir(parents=True, exist_ok=True)
-        out.write_text(json.dumps({"runs": keep + runs}, indent=1, default=float))
+        data = {"runs": keep + runs, "conditions": before.get("conditions", "")}
+        out.write_text(json.dumps(data, indent=1, default=float))
 
     run(tuple(args.cells), tuple(args.linear or ("direct", "iterative")), comm, save)
 

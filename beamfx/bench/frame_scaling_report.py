@@ -10,14 +10,18 @@ PHASES = ("assembly", "pc_setup", "solve", "other")
 
 
 def _runs(folder):
-    """{(cells, kinematics, linear, ranks): run} of the frame_scaling_np*.json files."""
-    runs = {}
+    """({(cells, kinematics, linear, ranks): run}, [conditions]) of the frame_scaling_np*.json
+    files; ``conditions`` are what the one who ran them wrote about the machine's load."""
+    runs, conditions = {}, []
     for f in sorted(Path(folder).glob("frame_scaling_np*.json")):
-        for r in json.loads(f.read_text())["runs"]:
+        data = json.loads(f.read_text())
+        for r in data["runs"]:
             runs[(r["cells"], r["kinematics"], r["linear"], r["ranks"])] = r
+        if data.get("conditions"):
+            conditions.append(f"{f.name}: {data['conditions']}")
     if not runs:
         raise SystemExit(f"{folder}: no frame_scaling_np*.json (run first)")
-    return runs
+    return runs, conditions
 
 
 def per_iteration(r):
@@ -36,7 +40,8 @@ def _table(runs):
         (
             "| cells | kinematics | linear solver | ranks | unknowns | Newton its | Krylov its "
             "| per Newton iteration s: assembly + PC set-up + solve + other = total "
-            "| µs per unknown and iteration (× ranks) | peak MiB per rank | model s | frame s |"
+            "| µs per unknown and iteration (× ranks) | peak MiB per rank (whole case; solve) "
+            "| model s | frame s |"
         ),
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
@@ -48,11 +53,22 @@ def _table(runs):
             f"| {r['cells']}³ | {r['kinematics']} | {r['linear']} | {r['ranks']} "
             f"| {r['unknowns']:,} | {r['newton_iterations']} | {r['krylov_iterations']} "
             f"| {split} = {per_iteration(r):.3g} | {us_per_unknown(r):.1f} "
-            f"| {' / '.join(f'{m:.0f}' for m in r['peak_MiB'])} "
-            f"| {r['seconds']['scene'] + r['seconds']['model']:.3g} "
-            f"| {r['seconds'].get('output', float('nan')):.3g} |"
+            f"| {_mib(r)} | {_s(r, 'scene') + _s(r, 'model'):.3g} | {_s(r, 'output'):.3g} |"
         )
     return lines
+
+
+def _s(r, key):
+    """Seconds of ``key`` outside the solve (NaN where the run did not record them)."""
+    return r.get("seconds", {}).get(key, float("nan"))
+
+
+def _mib(r):
+    """Peak MiB per rank: of the whole case, and of the solve where recorded."""
+    whole = " / ".join(f"{m:.0f}" for m in r["peak_MiB"])
+    if "peak_MiB_solve" not in r:
+        return whole
+    return f"{whole} (solve {' / '.join(f'{m:.0f}' for m in r['peak_MiB_solve'])})"
 
 
 def rank_differences(runs):
@@ -179,7 +195,7 @@ def _direct_line(runs, kin, a, b):
             else f"; its peak memory is no higher than the iterative run's there ({extra:.0f} "
             "MiB): the model, the forms and the output frame outweigh the factor at this size"
         )
-    return line + ". So 10⁶ unknowns are solved iteratively only."
+    return line + ". At 10⁶ only the iterative solver was run (for time)."
 
 
 def _kib(r, base):
@@ -208,8 +224,8 @@ def _why_lines(runs):
                 f"{b['unknowns']:,} unknowns: the CG iterations grow {its:.1f} times, the cost "
                 f"per unknown and CG iteration {per_it:.1f} times, the memory per unknown "
                 f"(above the libraries' {base:.0f} MiB) {_kib(b, base):.1f} KiB against "
-                f"{_kib(a, base):.1f} KiB. GAMG aggregates the unknowns one by one (the mixed space has "
-                "block size 1, so the six rigid-body motions are not given to it, see "
+                f"{_kib(a, base):.1f} KiB. GAMG aggregates the unknowns one by one (the mixed "
+                "space has block size 1, so the six rigid-body motions are not given to it, see "
                 "docs/scenes.md), and its coarse spaces miss the beams' soft bending modes: the "
                 "iterations grow with the lattice, like a one-level method's, only slower."
             )
@@ -242,7 +258,7 @@ def report(folder, notes=SETUP):
     """Write frame_scaling.md and .json in ``folder`` from its frame_scaling_np*.json files;
     ``notes``: the paragraphs after the title (markdown)."""
     folder = Path(folder)
-    runs = _runs(folder)
+    runs, conditions = _runs(folder)
     diffs = rank_differences(runs)
     lines = [
         "# Lattice frames from 10³ to 10⁶ unknowns on 1 and 2 ranks",
@@ -251,7 +267,14 @@ def report(folder, notes=SETUP):
         "",
         notes,
         "",
+        *[f"* {c}" for c in conditions],
+        *([""] if conditions else []),
         *_table(runs),
+        *[
+            f"\n{r['cells']}³ {r['kinematics']} {r['linear']}, {r['ranks']} rank(s): {r['note']}"
+            for r in runs.values()
+            if r.get("note")
+        ],
         *_cost_lines(runs),
         "",
         "## 1 rank against 2 ranks",
