@@ -22,6 +22,7 @@ NOT_USERS = {
     "spec",
     "checks",
     "trimming",
+    "mechanisms",  # part of BeamModel's build (model.py calls it on the model it builds)
 }
 #: modules that receive a formulation, and the protocol whose members they may use: static
 #: solves, the writers and the runner any Formulation (the condensed model too); the other
