@@ -34,6 +34,7 @@ class CampbellResult(NamedTuple):
     steady: tuple  # StaticResult per speed
     stopped_by: str | None  # why the sweep ended early (no steady state), else None
     failure: Exception | None = None  # a numerical failure that ended the sweep (SolveFailed)
+    eigen_seconds: tuple = ()  # per speed: the eigen solve's compile, assemble and solve times
 
 
 def track(previous, candidates, M):
@@ -65,7 +66,7 @@ def campbell(
 
     model = frame.model
     done, freq, b_hz, b_growth, b_mac, b_out, stable, steady = ([] for _ in range(8))
-    shapes, stopped_by, failure = None, None, None
+    shapes, stopped_by, failure, eigen = None, None, None, []
     for speed in speeds:
         try:
             steady.append(solve_steady(frame, speed, steps=steps, options=options))
@@ -88,6 +89,7 @@ def campbell(
             order, mac = track(shapes, modes.vectors, M)
             M.destroy()
         shapes = [modes.vectors[i] for i in order]
+        eigen.append(modes.seconds)
         done.append(speed)
         freq.append(modes.hz[:n_modes])
         b_hz.append(modes.hz[order])
@@ -114,6 +116,7 @@ def campbell(
         tuple(steady),
         stopped_by,
         failure,
+        tuple(eigen),
     )
 
 

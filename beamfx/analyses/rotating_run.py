@@ -117,6 +117,17 @@ def _branches(result):
     )
 
 
+def _seconds(result):
+    """Assembly and solve times of the steady states (Newton) and eigen solves, and the total."""
+    steady = [s.seconds for s in result.steady]
+    assemble = sum(s.get("assemble_F", 0.0) + s.get("assemble_J", 0.0) for s in steady)
+    solve = sum(s.get("solve", 0.0) for s in steady)
+    assemble += sum(e.get("assemble", 0.0) for e in result.eigen_seconds)
+    solve += sum(e.get("solve", 0.0) for e in result.eigen_seconds)
+    total = sum(s["total"] for s in steady) + sum(sum(e.values()) for e in result.eigen_seconds)
+    return {"assemble": float(assemble), "solve": float(solve), "total": float(total)}
+
+
 def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Steady state and frequencies at every speed; the Campbell files in the output folder."""
     from .campbell import campbell, write_campbell
@@ -161,7 +172,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         failure=dict(getattr(failure, "details", None) or {}) or None,
         load_steps=tuple(steps),
         newton_iterations=int(sum(s.iterations for s in steps)),
-        seconds={"total": float(sum(s.seconds["total"] for s in result.steady))},
+        seconds=_seconds(result),
         axis=tuple(frame.axis.tolist()),
         hub={
             "at": settings.hub if isinstance(settings.hub, str) else None,
