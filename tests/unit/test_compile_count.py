@@ -126,3 +126,25 @@ def test_speed_sweep_compiles_nothing_after_the_first_speed(jit):
     assert len(seen) == 4
     # the modes of the first speed are solved after on_speed: compare from the second speed on
     assert len(set(seen[1:])) == 1, seen
+
+
+def test_a_loaded_jit_module_is_answered_from_memory():
+    """A form compiled (or loaded) once is not looked up in the JIT cache folder again: the
+    second request returns the very objects of the first (forms.remember_loaded_modules)."""
+    import dolfinx
+    import ufl
+    from ffcx.codegeneration import jit
+    from mpi4py import MPI
+
+    from beamfx.solvers.forms import compile_form
+
+    mesh = dolfinx.mesh.create_unit_interval(MPI.COMM_WORLD, 2)
+    V = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1))
+    u = dolfinx.fem.Function(V)
+    form = u * u * ufl.dx(metadata={"quadrature_degree": 2})
+    first = compile_form(form)
+    memo = jit.get_cached_module.loaded
+    names = [k[0] for k in memo if k[0].startswith("libffcx_forms_")]
+    assert names, "the form's module is remembered"
+    second = compile_form(form)
+    assert first.ufcx_form == second.ufcx_form
