@@ -128,56 +128,20 @@ def rotation_values(u, R):
     }
 
 
-def hub_angle(t):
-    """ψ(t) of vm258_spin_up.json, as beamfx.bench.transient.hub_angle."""
-    t = np.asarray(t, float)
-    ramp = (6 / 15) * (t**2 / 2 + (15 / (2 * np.pi)) ** 2 * (np.cos(2 * np.pi * t / 15) - 1))
-    return np.where(t < 15, ramp, 6 * t - 45)
+def _spin_measure():
+    """beamfx's spin-up measure (beamfx/bench/spin_measure.py, numpy only), loaded by its path:
+    this venv has none of beamfx's dependencies, and both sides must score alike."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[1] / "beamfx" / "bench" / "spin_measure.py"
+    spec = importlib.util.spec_from_file_location("beamfx_spin_measure", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def least(t, y):
-    """As beamfx.bench.transient.least: the minimum between the samples (a quartic through
-    the five samples around the least one)."""
-    i = int(np.argmin(y))
-    lo = min(max(i - 2, 0), max(len(y) - 5, 0))
-    ts, ys = t[lo : lo + 5], y[lo : lo + 5]
-    if len(ts) < 5 or i in (0, len(y) - 1):
-        return float(y[i])
-    scale = ts[-1] - ts[0]
-    poly = np.polynomial.Polynomial.fit((ts - t[i]) / scale, ys, 4, domain=[-1, 1], window=[-1, 1])
-    a, b = (t[i - 1] - t[i]) / scale, (t[i + 1] - t[i]) / scale
-    roots = poly.deriv().roots()
-    candidates = [r.real for r in roots if abs(r.imag) < 1e-12 and a <= r.real <= b]
-    return float(min([y[i], *(poly(r) for r in candidates)]))
-
-
-def time_mean(t, y, start, end):
-    """As beamfx.bench.transient.time_mean: Simpson on a uniform even grid, else trapezoidal."""
-    m = (t >= start - 1e-9) & (t <= end + 1e-9)
-    ts, ys = t[m], y[m]
-    span = ts[-1] - ts[0]
-    if np.ptp(np.diff(ts)) < 1e-6 * (ts[1] - ts[0]) and len(ts) % 2 == 1:
-        h = span / (len(ts) - 1)
-        area = h / 3 * (ys[0] + ys[-1] + 4 * ys[1:-1:2].sum() + 2 * ys[2:-1:2].sum())
-    else:
-        area = np.trapz(ys, ts)
-    return float(area / span)
-
-
-def spin_up_values(t, x, y, theta, L):
-    """beamfx's spin-up measure from the tip history: positions (x, y) and the planar angle."""
-    t, x, y, theta = (np.asarray(a, float) for a in (t, x, y, theta))
-    psi = hub_angle(t)
-    c, s = np.cos(psi), np.sin(psi)
-    axial = c * x + s * y - L
-    transverse = -s * x + c * y
-    rel = theta - psi
-    return {
-        "axial_min": least(t, axial),
-        "transverse_min": least(t, transverse),
-        "relative_rotation_min": least(t, rel),
-        "stretch_mean_15_18": time_mean(t, axial, 15.0, 18.0),
-    }
+_SPIN = _spin_measure()
+hub_angle, spin_up_values = _SPIN.hub_angle, _SPIN.spin_up_values
 
 
 def out_dir():

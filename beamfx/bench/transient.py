@@ -18,18 +18,12 @@ from ..physics.sections import Section
 from ..spec import Beam, Model, PointLoad, Support
 from ._builders import CLAMP, arc
 from .registry import Case, reference, register
+from .spin_measure import hub_angle, spin_up_values
 
 SPIN = reference("vm258_spin_up.json")
 P = SPIN["properties"]
 L, OMEGA = P["L"], 6.0
 HAND_STRETCH = P["rho_A"] * OMEGA**2 * L**3 / (3 * P["EA"])
-
-
-def hub_angle(t):
-    """ψ(t) of vm258_spin_up.json: (6/15)(t²/2 + (15/2π)²(cos(2πt/15) − 1)), then 6t − 45."""
-    t = np.asarray(t, float)
-    ramp = (6 / 15) * (t**2 / 2 + (15 / (2 * np.pi)) ** 2 * (np.cos(2 * np.pi * t / 15) - 1))
-    return np.where(t < 15, ramp, 6 * t - 45)
 
 
 def spin_up_model(elements, degree):
@@ -186,54 +180,11 @@ def spin_up_series(history):
     }
 
 
-def least(t, y):
-    """The least value of the smooth function sampled as ``y`` at times ``t``: the quartic
-    through the five samples around the least sample, minimised between its neighbours, so
-    that the sampling adds an error O(dt⁵) instead of the O(dt²) of the least sample."""
-    i = int(np.argmin(y))
-    lo = min(max(i - 2, 0), max(len(y) - 5, 0))
-    ts, ys = t[lo : lo + 5], y[lo : lo + 5]
-    if len(ts) < 5 or i in (0, len(y) - 1):  # at an end: the sample is the extreme
-        return float(y[i])
-    scale = ts[-1] - ts[0]
-    poly = np.polynomial.Polynomial.fit((ts - t[i]) / scale, ys, 4, domain=[-1, 1], window=[-1, 1])
-    a, b = (t[i - 1] - t[i]) / scale, (t[i + 1] - t[i]) / scale
-    roots = poly.deriv().roots()
-    candidates = [r.real for r in roots if abs(r.imag) < 1e-12 and a <= r.real <= b]
-    return float(min([y[i], *(poly(r) for r in candidates)]))
-
-
-def time_mean(t, y, start, end):
-    """Mean of the sampled ``y`` over [``start``, ``end``] (samples at both ends): Simpson's
-    rule on a uniform even grid, else the trapezoidal rule."""
-    m = (t >= start - 1e-9) & (t <= end + 1e-9)
-    ts, ys = t[m], y[m]
-    span = ts[-1] - ts[0]
-    if np.ptp(np.diff(ts)) < 1e-6 * (ts[1] - ts[0]) and len(ts) % 2 == 1:
-        h = span / (len(ts) - 1)
-        area = h / 3 * (ys[0] + ys[-1] + 4 * ys[1:-1:2].sum() + 2 * ys[2:-1:2].sum())
-    else:
-        area = np.trapz(ys, ts)
-    return float(area / span)
-
-
 def spin_up_measure(history, spec=None):
-    """Spin-up quantities from the (t, tip position, planar angle) history: least axial and
-    transverse tip displacement in the rotating frame, least relative rotation (each between
-    the samples: :func:`least`), mean stretch over 15–18 s (:func:`time_mean`)."""
-    t = np.array([h[0] for h in history])
+    """Spin-up quantities from the (t, tip position, planar angle) history
+    (:func:`.spin_measure.spin_up_values`)."""
     x = np.array([h[1] for h in history])
-    psi = hub_angle(t)
-    c, s = np.cos(psi), np.sin(psi)
-    axial = c * x[:, 0] + s * x[:, 1] - L
-    transverse = -s * x[:, 0] + c * x[:, 1]
-    relative = np.array([h[2] for h in history]) - psi  # the planar angle needs no unwrapping
-    return {
-        "axial_min": least(t, axial),
-        "transverse_min": least(t, transverse),
-        "relative_rotation_min": least(t, relative),
-        "stretch_mean_15_18": time_mean(t, axial, 15.0, 18.0),
-    }
+    return spin_up_values([h[0] for h in history], x[:, 0], x[:, 1], [h[2] for h in history], L)
 
 
 #: ρ∞ of the extrapolated spin-up: with 0.9 the runs at dt = 0.025 need cut-backs near

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from beamfx.bench.transient import least, time_mean
+from beamfx.bench.spin_measure import least, time_mean
 
 
 def test_least_reads_the_minimum_between_samples():
