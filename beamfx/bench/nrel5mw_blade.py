@@ -14,6 +14,7 @@ reference, and the table shows the convergence. pyBModes (``make bench-peers``) 
 same blade where it is installed.
 """
 
+import math
 import tomllib
 from pathlib import Path
 
@@ -23,7 +24,7 @@ from .scenes import SceneCase
 FOLDER = Path(__file__).resolve().parents[2] / "meshes" / "nrel5mw_blade"
 SCENE = FOLDER / "blade_modes.toml"
 #: rated rotor speed, 12.1 rpm in rad/s
-RATED = 12.1 * 2 * 3.141592653589793 / 60
+RATED = 12.1 * 2 * math.pi / 60
 MODES = 6
 
 

@@ -9,6 +9,7 @@ The source shows the settled shapes as curves, without numbers: the reference is
 converged here (the finest setting is the reference, error = max |Δ| / L).
 """
 
+import math
 import tomllib
 from importlib import resources
 
@@ -30,7 +31,7 @@ def _scene(elements, degree):
 def _read(result):
     values = {}
     for state in result.path:
-        hz = state["speed_rad_s"] / (2 * 3.141592653589793)
+        hz = state["speed_rad_s"] / (2 * math.pi)
         tip = state["probes"]["tip"]["position"]
         values.update({f"y_{hz:.0f}Hz": tip[1], f"z_{hz:.0f}Hz": tip[2]})
     return values

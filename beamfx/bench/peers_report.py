@@ -18,6 +18,8 @@ Times (seconds; each record's fields):
 The verdict uses whole runs; the solve-only verdict stands beside it.
 """
 
+from .peers_score import line, summary
+
 # why the numbers look as they do (facts of the methods, not of one run)
 NOTES = {
     "rollup_half": "Exudyn's two-node BeamGeometricallyExact interpolates on SE(3): a constant-"
@@ -87,8 +89,6 @@ def plot(records, problem, title, path, target=None):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from .peers_score import line
 
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     groups = {}
@@ -174,8 +174,6 @@ def _solve_verdict(s):
 
 def summary_table(records, problems):
     """The summary table and, where beamfx is not ahead, by how much (lines of markdown)."""
-    from .peers_score import summary
-
     lines = [
         (
             "| problem | target | beamfx: whole s (setting; solve; process) | peers: whole s to "
@@ -219,8 +217,6 @@ def _behind(pid, s):
 
 def problem_section(records, pid, meta, s, note=None):
     """Markdown lines of one problem: target, plot, every record, the note."""
-    from .peers_score import line
-
     out = [
         "",
         f"## {pid}: {meta.get('title', '')}",
@@ -248,8 +244,6 @@ def problem_section(records, pid, meta, s, note=None):
 def markdown(records, problems, notes=None):
     """The report: the summary table (whole runs to the target per code), by how much beamfx
     is behind where it is, then per problem the full table, its plot and its note."""
-    from .peers_score import summary
-
     lines = ["# beamfx beside its peers", "", INTRO, "", *summary_table(records, problems)]
     for pid, meta in problems.items():
         note = (notes or {}).get(pid)
