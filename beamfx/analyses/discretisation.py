@@ -266,6 +266,16 @@ class Discretisation:
         per_beam = [1.0 if i == beam_index else 0.0 for i in range(len(self.spec.beams))]
         return self.cell_function(np.asarray(per_beam, float)[self.mesh.cell_beam])
 
+    def beam_profile(self, beam_index, f):
+        """DG_p Function: f(s) at the interpolation points of the cells of one beam (s the arc
+        length along it), 0 elsewhere."""
+        q = self.mesh.degree
+        S = self.cell_arc_lengths(dg_points(q))
+        values = np.zeros_like(S)
+        sel = self.mesh.cell_beam == beam_index
+        values[sel] = np.asarray(f(S[sel]), float)
+        return cell_field(self.mesh.mesh, q, values)
+
     def min_cell_length(self):
         """Shortest cell, in arc length (all ranks). Collective."""
         return self.comm.allreduce(np.min(np.diff(self.mesh.cell_span, axis=1)), op=MPI.MIN)

@@ -119,7 +119,12 @@ class BeamModel(Discretised):
             work += self._history_factor(ld) * d.at_point(ld.at, work_of(ld), exact)
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
-            on_beam = 1.0 if dl.beam is None else d.beam_indicator(names.index(dl.beam))
+            if dl.beam is None:
+                on_beam = 1.0
+            elif dl.profile is None:
+                on_beam = d.beam_indicator(names.index(dl.beam))
+            else:  # the profile at the interpolation points, like a section varying along s
+                on_beam = d.beam_profile(names.index(dl.beam), dl.profile)
             work += self._history_factor(dl) * on_beam * work_of(dl) * d.dx
         if any(spec.gravity):
             rho_A = d.inertia[0]

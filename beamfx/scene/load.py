@@ -69,7 +69,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     mat = read_material(top.table("material", None))
     beams = _beams(top, mat, base, limits)
     supports = read_supports(top)
-    point_loads, distributed, gravity = read_loads(top)
+    point_loads, distributed, gravity = read_loads(top, {b.name: b.curve.length for b in beams})
     frames = read_frames(top, base, limits, partial(read_section, mat=mat, length=1.0), beams)
     beams, supports = beams + frames.beams, supports + frames.supports
     point_loads += frames.point_loads

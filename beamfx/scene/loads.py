@@ -16,6 +16,7 @@ from ..spec import (
     Support,
 )
 from .expr import compile_expression, table_function
+from .sections import span_function
 from .table import Table, is_number
 
 FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
@@ -145,8 +146,27 @@ def read_supports(top):
     return supports
 
 
-def read_loads(top):
-    """``[[loads]]``: point loads, distributed loads and gravity."""
+def _profile(t, lengths):
+    """``profile`` of a distributed load: its force and moment per length times a function of
+    the arc length along its beam (``beam`` is required: s and L are that beam's); None if
+    absent."""
+    if not t.has("profile"):
+        return None
+    beam = t.data.get("beam")
+    if beam is None:
+        t.fail("profile", "a profile runs along one beam: give 'beam' too")
+    if beam not in lengths:
+        t.fail("beam", f"{beam!r} is no beam; beams are {list(lengths)}")
+    f = span_function(t, "profile", lengths[beam])
+    if not callable(f):
+        value = f
+        f = partial(np.full_like, fill_value=value, dtype=float)
+        f.text = str(value)
+    return f
+
+
+def read_loads(top, lengths):
+    """``[[loads]]``: point loads, distributed loads and gravity; ``lengths``: {beam: length}."""
     point_loads, distributed, gravity, gravity_at = [], [], (0.0, 0.0, 0.0), None
     for t in top.tables("loads"):
         if t.has("gravity"):
@@ -180,6 +200,7 @@ def read_loads(top):
                     _history(t),
                     arm=_arm(t, kind, "moment_per_length"),
                     axes=axes,
+                    profile=_profile(t, lengths),
                 )
             )
         t.done(

@@ -155,36 +155,42 @@ def beamdyn_section(t, length, base):
     return ms.MatrixSection(C, Mb, stations, length, vertices)
 
 
-def read_twist(t, length):
-    """``twist_deg`` of a beam table ``t``: a number (degrees), an expression of the arc length
-    ``s`` (and ``L``) or a table ``{ s = [...], values = [...] }`` (piecewise linear in s),
-    finite along the beam (negative values allowed)."""
+def span_function(t, key, length, default=0.0):
+    """A value along a beam of ``length`` from key ``key`` of table ``t``: a number, an
+    expression of the arc length ``s`` (and ``L``) or a table ``{ s = [...], values = [...] }``
+    (piecewise linear in s), finite along the beam (negative values allowed). A number is
+    returned as a float, the others as a vectorised function of s."""
     from .expr import compile_expression, table_function
     from .table import MAX_MAGNITUDE, Table
 
-    raw = t.data.get("twist_deg", 0.0)
+    raw = t.data.get(key, default)
     if not isinstance(raw, (str, dict)):
-        value = t.get("twist_deg", float, 0.0)
+        value = t.get(key, float, default)
         if not abs(value) <= MAX_MAGNITUDE:
-            t.fail("twist_deg", f"= {value:g}: must be a finite number")
+            t.fail(key, f"= {value:g}: must be a finite number")
         return value
-    t.used.add("twist_deg")
+    t.used.add(key)
     try:
         if isinstance(raw, str):
             f = compile_expression(raw, "s", {"L": length})
         else:
-            sub = Table(raw, t.path + ".twist_deg", t.file)
+            sub = Table(raw, t.path + "." + key, t.file)
             f = table_function(sub.get("s", list), sub.get("values", list))
             sub.done()
         samples = f(np.linspace(0.0, length, 201))
     except (ValueError, TypeError, ZeroDivisionError, FloatingPointError, OverflowError) as e:
         t.fail(
-            "twist_deg",
+            key,
             f"{e} (write a number, an expression of s and L, or {{ s = [...], values = [...] }})",
         )
     if not np.all(np.abs(samples) <= MAX_MAGNITUDE):
-        t.fail("twist_deg", "must be finite along the whole beam")
+        t.fail(key, "must be finite along the whole beam")
     return f
+
+
+def read_twist(t, length):
+    """``twist_deg`` of a beam table ``t``, in degrees (:func:`span_function`)."""
+    return span_function(t, "twist_deg", length)
 
 
 SHAPE_TYPES = ("shape", "polygon")

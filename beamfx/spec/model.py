@@ -66,7 +66,8 @@ class DistributedLoad:
     """Force and moment per unit reference length on ``beam`` (all beams if None); ``kind``
     and ``arm`` as in :class:`PointLoad`. ``axes``: "global", or "section" for components in
     the section axes of the undeformed beam (a radial load on an arc: then a dead load keeps
-    the undeformed radial direction and a follower load turns with the section, a pressure)."""
+    the undeformed radial direction and a follower load turns with the section, a pressure).
+    ``profile``: a function of the arc length along ``beam`` that multiplies both."""
 
     beam: str | None = None
     force: tuple = (0.0, 0.0, 0.0)
@@ -75,6 +76,7 @@ class DistributedLoad:
     history: object = None  # f(t) scaling force and moment in a transient (None: 1)
     arm: tuple | None = None
     axes: str = "global"
+    profile: object = None  # f(s) along ``beam`` scaling force and moment (None: 1)
 
     def directions(self, beams):
         """The global force and moment per length along ``beams`` (sampled at 101 points of
