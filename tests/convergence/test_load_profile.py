@@ -96,3 +96,28 @@ def test_a_profile_needs_its_beam(scene_file):
     with pytest.raises(SceneError) as e:
         load_scene(scene_file(text))
     assert "loads[0].profile" in str(e.value) and "give 'beam'" in str(e.value)
+
+
+def test_internal_moment_equals_the_moment_of_the_load_beyond_each_section(scene_file):
+    """Howcroft et al.'s check along the span (beamfx.bench.span_equilibrium) on a cantilever
+    under a follower profile in section axes at large deflection: the recovered moment of the
+    cubic elements converges to the load's moment as h^3 (p = 3), so halving the elements
+    divides the mismatch by about 8; at least 6 is asked."""
+    from dataclasses import replace
+
+    from beamfx.analyses.model import BeamModel
+    from beamfx.analyses.static import solve_static
+    from beamfx.bench.span_equilibrium import mismatch, span_moments
+
+    extra = '\nkind = "follower"\naxes = "section"'
+    text = TEXT.replace("PROFILE", 'profile = "1 - (s / L) ** 2"' + extra)
+    text = text.replace("ANALYSIS", "static").replace(f"{Q0}]", f"{400 * Q0}]")
+    spec = load_scene(scene_file(text)).model
+    load = spec.distributed_loads[0]
+    errors = []
+    for elements in (4, 8):
+        beams = (replace(spec.beams[0], elements=elements),)
+        model = BeamModel(replace(spec, beams=beams))
+        solve_static(model, steps=10)
+        errors.append(mismatch(span_moments(model, load.force, load.profile)))
+    assert errors[1] < 1e-3 and errors[0] / errors[1] > 6

@@ -7,8 +7,16 @@ import pytest
 
 DEMOS = sorted((Path(__file__).parents[2] / "demos").glob("*.py"))
 
+#: demos of a minute or more (a 61.5 m blade solved a dozen times): in the slow set
+SLOW = {"blade_prebend"}
 
-@pytest.mark.parametrize("demo", DEMOS, ids=[d.stem for d in DEMOS])
+
+def _params(demos):
+    marks = {True: [pytest.mark.slow], False: []}
+    return [pytest.param(d, id=d.stem, marks=marks[d.stem in SLOW]) for d in demos]
+
+
+@pytest.mark.parametrize("demo", _params(DEMOS))
 def test_demo_runs_and_checks_its_result(demo):
     runpy.run_path(str(demo), run_name="__main__")
 
@@ -19,6 +27,6 @@ MPI_DEMOS = [d for d in DEMOS if d.stem != "bend45"]
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize("demo", MPI_DEMOS, ids=[d.stem for d in MPI_DEMOS])
+@pytest.mark.parametrize("demo", _params(MPI_DEMOS))
 def test_demo_under_mpi(demo):
     runpy.run_path(str(demo), run_name="__main__")
