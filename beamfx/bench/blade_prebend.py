@@ -33,7 +33,7 @@ def _scene(elements, degree, factor, steps):
 
 def _reader(level):
     def read(result):
-        tip = result.probes["tip"]["position"]
+        tip = result.path[-1]["probes"]["tip"]["position"]
         return {f"{axis}_{level}": tip[i] for i, axis in enumerate("xyz")}
 
     return read
