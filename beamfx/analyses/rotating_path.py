@@ -1,0 +1,125 @@
+r"""Steady states along a list of speeds by natural continuation in Ω².
+
+A sweep of speeds (:func:`~beamfx.analyses.campbell.campbell`) solves each steady state from
+the previous speed's one instead of from the undeformed state: the loads stay at their full
+value (load factor 1) and the march parameter s ∈ [0, 1] of
+:func:`~beamfx.solvers.stepping.step_load` moves the speed from Ω_a to Ω_b with
+
+    Ω(s)² = Ω_a² + s (Ω_b² − Ω_a²),
+
+the centrifugal load being linear in Ω². The whole interval is tried first; the step
+controller (:mod:`~beamfx.solvers.step_control`, through ``step_load``) cuts it back when
+Newton fails and grows it again after easy steps. Each step starts from the secant through the
+last two converged states in Ω² (those of the previous speeds, then of the sub-steps).
+
+At s = 1 the residual test is the same as for a steady state solved from the undeformed state
+(the force scale is the load vector's norm at the target speed), so both reach the same steady
+state to the convergence tolerance.
+"""
+
+import math
+
+from ..solvers.stepping import SavedState
+
+
+class SpeedPath:
+    """The last two converged steady states of a sweep: (Ω², unknowns), oldest first."""
+
+    def __init__(self):
+        self.states = []
+
+    def add(self, speed, w):
+        """Keep the converged state of the Function ``w`` at ``speed`` (rad/s)."""
+        q = float(speed) ** 2
+        self.states = [s for s in self.states if s[0] != q][-1:] + [(q, w.x.array.copy())]
+
+    def last_speed(self):
+        """Ω of the last converged state (rad/s, ≥ 0), or None."""
+        return math.sqrt(self.states[-1][0]) if self.states else None
+
+
+class _PathState(SavedState):
+    """Save/restore for ``step_load``'s cut-backs, and the secant predictor in Ω² through the
+    last two converged states (the path's, then the sub-steps')."""
+
+    def __init__(self, w, path, square):
+        super().__init__(w)
+        self.known = list(path.states)  # (Ω², unknowns), converged
+        self.square = square  # s -> Ω²
+
+    def predict(self, s, target):
+        """Start from w_n + (Ω_t² − Ω_n²)/(Ω_n² − Ω_{n−1}²) (w_n − w_{n−1})."""
+        q = self.square(s)
+        if self.known[-1][0] != q:  # a sub-step converged at s (its state just saved)
+            self.known = self.known[-1:] + [(q, self.saved.copy())]
+        if len(self.known) < 2:
+            return
+        (q_0, w_0), (q_1, w_1) = self.known[-2:]
+        ratio = (self.square(target) - q_1) / (q_1 - q_0)
+        self.w.x.array[:] = w_1 + ratio * (w_1 - w_0)
+        self.w.x.scatter_forward()
+
+
+def continue_steady(frame, path, speed, solver, log=None):
+    """The steady state at ``speed`` from the path's last one (Ω² marched, loads at full).
+
+    Returns (accepted load steps, seconds of the solver's parts). Raises
+    :class:`~beamfx.solvers.snes.SolveFailed` as :func:`~beamfx.solvers.stepping.step_load`,
+    with ``details["speed_rad_s"]``: the speed of the last converged state, which the model
+    then holds (the frame is left at ``speed``).
+    """
+    from ..solvers import SolveFailed, step_load
+    from .static import load_scale, state_sizes, tangent_condition
+
+    model = frame.model
+    q_a, q_b = path.states[-1][0], float(speed) ** 2
+    sign = -1.0 if speed < 0 else 1.0
+
+    def square(s):
+        return q_b if s >= 1.0 else q_a + s * (q_b - q_a)
+
+    def speed_at(s):
+        return float(speed) if s >= 1.0 else sign * math.sqrt(max(square(s), 0.0))
+
+    def solve_at(s):
+        frame.set_speed(speed_at(s))
+        solver.set_scale(load_scale(model, solver.F))  # the load at this speed
+        report = solver.solve()
+        if report.converged:
+            model.check_state()
+        return report
+
+    model.w.x.array[:] = path.states[-1][1]
+    model.w.x.scatter_forward()
+    model.set_load_factor(1.0)
+    solver.set_sizes(state_sizes(model))
+    before = dict(solver.seconds)
+    state = _PathState(model.w, path, square)
+    try:
+        history = step_load(solve_at, state, steps=1, log=log)
+    except SolveFailed as e:
+        s_last = e.history[-1].load_factor if e.history else 0.0
+        e.details["speed_rad_s"] = speed_at(s_last)
+        e.details["condition_estimate"] = tangent_condition(solver)  # at that state
+        frame.set_speed(speed)
+        e.args = (
+            f"continuing the steady state from {speed_at(0.0):.6g} to {float(speed):.6g} "
+            f"rad/s (load factor: the share of the step in Ω²): {e.args[0]}",
+        )
+        raise
+    spent = {k: v - before.get(k, 0.0) for k, v in solver.seconds.items()}
+    return history, spent
+
+
+def speed_of_failure(frame, error):
+    """(load factor, speed) of the last converged state of a failed steady-state solve: that
+    of a continuation (loads at full, ``details["speed_rad_s"]``), else of the ramp from the
+    undeformed state at the frame's speed."""
+    details = getattr(error, "details", None) or {}
+    if "speed_rad_s" in details:
+        return 1.0, float(details["speed_rad_s"])
+    steps = getattr(error, "history", ())
+    return (steps[-1].load_factor if steps else 0.0), frame.speed
+
+
+__all__ = ["SpeedPath", "continue_steady", "speed_of_failure"]
