@@ -49,6 +49,17 @@ def track(previous, candidates, M):
     return order, mac[np.arange(len(previous)), order]
 
 
+def _follow(frame, shapes, modes, n_modes):
+    """(order, MAC) of the branches among ``modes``: the first ``n_modes`` at the first
+    speed (``shapes`` None), else tracked from ``shapes`` (:func:`track`)."""
+    if shapes is None:
+        return np.arange(n_modes), np.ones(n_modes)
+    M = assemble_mass(frame)
+    order, mac = track(shapes, modes.vectors, M)
+    M.destroy()
+    return order, mac
+
+
 def campbell(
     frame,
     speeds,
@@ -95,12 +106,7 @@ def campbell(
                 log(f"  {speed:.6g} rad/s: {str(e).splitlines()[0]}")
             steady = steady[: len(done)]
             break
-        if shapes is None:
-            order, mac = np.arange(n_modes), np.ones(n_modes)
-        else:
-            M = assemble_mass(frame)
-            order, mac = track(shapes, modes.vectors, M)
-            M.destroy()
+        order, mac = _follow(frame, shapes, modes, n_modes)
         shapes = [modes.vectors[i] for i in order]
         eigen.append(modes.seconds)
         done.append(speed)
