@@ -102,11 +102,25 @@ def continue_steady(frame, path, speed, solver, log=None):
         e.details["speed_rad_s"] = speed_at(s_last)
         e.details["condition_estimate"] = tangent_condition(solver)  # at that state
         frame.set_speed(speed)
-        head = f"continuing the steady state from {speed_at(0.0):.6g} to {float(speed):.6g} "
-        e.args = (head + f"rad/s (load factor: the share of the step in Ω²): {e.args[0]}",)
+        _explain(e, speed_at(0.0), float(speed))
         raise
     spent = {k: v - before.get(k, 0.0) for k, v in solver.seconds.items()}
     return history, spent
+
+
+def _explain(error, start, speed):
+    """Say in ``error`` (a :class:`SolveFailed` of ``step_load``) that it is a continuation
+    from ``start`` to ``speed``, and suggest intermediate speeds where its remedy suggests
+    more load steps (``steps`` sets only the first steady state's)."""
+    import re
+
+    more = f"more speeds between {start:.6g} and {speed:.6g} rad/s in speeds_rad_s"
+    message, fix = error.args[0], error.remedy
+    if fix:
+        new = re.sub(r"\[analysis\] steps = \S+?( \(or more\))?(?=;|$)", more, fix)
+        message, error.remedy = message.replace(fix, new), new
+    head = f"continuing the steady state from {start:.6g} to {speed:.6g} rad/s (load factor: "
+    error.args = (f"{head}the share of the step in Ω²): {message}",)
 
 
 def speed_of_failure(frame, error):

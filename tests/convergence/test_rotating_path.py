@@ -100,3 +100,33 @@ def test_a_continuation_converges_below_the_divergence_speed_and_stops_past_it(s
         with pytest.raises(NoSteadyState):
             solve_steady(frame, speeds[-1], path=path)
     frame.destroy()
+
+
+def test_a_numerical_failure_of_a_continuation_names_the_speeds_and_is_not_a_stop():
+    """Newton with no preconditioner (the 'linear solve' is the identity) fails from 0 to
+    100 rad/s: a numerical failure (the tangent is positive definite at the last converged
+    state, the one at 0 rad/s), whose remedy asks for speeds in between, not load steps."""
+    from beamfx.analyses.rotating_checks import NoSteadyState
+    from beamfx.bench._builders import CLAMP, straight
+    from beamfx.physics import sections
+    from beamfx.physics.kinematics import Kinematics
+    from beamfx.solvers.snes import SolveFailed
+    from beamfx.spec import Beam, Model, Support
+
+    section = sections.rectangle(2.1e11, 2.1e11 / 2.6, 7850.0, 0.02, 0.04)
+    spec = Model(
+        beams=(Beam("b", straight(1.0), section, 4, 3),),
+        supports=(Support("b:start", CLAMP),),
+        kinematics=Kinematics(),
+    )
+    frame = RotatingFrame(BeamModel(spec))
+    path = SpeedPath()
+    solve_steady(frame, 0.0, path=path)
+    with pytest.raises(SolveFailed) as caught:
+        solve_steady(frame, 100.0, options={"pc_type": "none"}, path=path)
+    frame.destroy()
+    e = caught.value
+    assert not isinstance(e, NoSteadyState)
+    assert e.details["speed_rad_s"] == 0.0 and "stays positive definite" in e.details["tangent"]
+    assert "more speeds between 0 and 100 rad/s" in e.remedy and "steps =" not in e.remedy
+    assert str(e).count(e.remedy) == 1 and "continuing the steady state from 0 to 100" in str(e)
