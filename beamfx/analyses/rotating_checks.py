@@ -75,12 +75,22 @@ def steady_state_lost(frame, lam_last, speed_last=None):
     return False, f"the tangent stays positive definite ({numbers})"
 
 
+def speed_of_failure(frame, error):
+    """(load factor, speed) of the last converged state of a failed steady-state solve: that
+    of a continuation (loads at full, ``details["speed_rad_s"]``:
+    :func:`~beamfx.analyses.rotating_path.continue_steady`), else of the ramp from the
+    undeformed state at the frame's speed."""
+    details = getattr(error, "details", None) or {}
+    if "speed_rad_s" in details:
+        return 1.0, float(details["speed_rad_s"])
+    steps = getattr(error, "history", ())
+    return (steps[-1].load_factor if steps else 0.0), frame.speed
+
+
 def classify_failure(frame, error):
     """The exception to raise for a failed steady state at the frame's speed: a
     :class:`NoSteadyState` if :func:`steady_state_lost`, else ``error`` (a numerical failure)
     with the tangent's verdict added to its message and details."""
-    from .rotating_path import speed_of_failure
-
     steps = getattr(error, "history", ())
     lost, why = steady_state_lost(frame, *speed_of_failure(frame, error))
     speed = f"{frame.speed:.6g} rad/s"
