@@ -49,8 +49,27 @@ def track(previous, candidates, M):
     return order, mac[np.arange(len(previous)), order]
 
 
+def _follow(frame, shapes, modes, n_modes):
+    """(order, MAC) of the branches among ``modes``: the first ``n_modes`` at the first
+    speed (``shapes`` None), else tracked from ``shapes`` (:func:`track`)."""
+    if shapes is None:
+        return np.arange(n_modes), np.ones(n_modes)
+    M = assemble_mass(frame)
+    order, mac = track(shapes, modes.vectors, M)
+    M.destroy()
+    return order, mac
+
+
 def campbell(
-    frame, speeds, n_modes=6, steps=10, options=None, extra_modes=2, on_speed=None, log=None
+    frame,
+    speeds,
+    n_modes=6,
+    steps=10,
+    options=None,
+    extra_modes=2,
+    on_speed=None,
+    log=None,
+    continued=True,
 ):
     """Steady state and the ``n_modes`` lowest modes at each speed of ``speeds`` (rad/s), in
     the given order; branches start from the modes at the first speed, lowest first.
@@ -60,16 +79,21 @@ def campbell(
     (:func:`~beamfx.analyses.rotating.solve_steady`) ends the sweep; ``stopped_by`` says why.
     ``on_speed(i, speed)`` is called with the model at each steady state reached (i from 1).
     A numerical failure (Newton or an eigen solve) also ends it; ``failure`` holds it.
+    ``continued``: each steady state starts from the previous speed's
+    (:mod:`~beamfx.analyses.rotating_path`); else each is ramped from rest in ``steps``.
+    The first one is always ramped from rest.
     """
     from ..solvers.snes import SolveFailed
     from .rotating_checks import NoSteadyState
+    from .rotating_path import SpeedPath
 
     model = frame.model
     done, freq, b_hz, b_growth, b_mac, b_out, stable, steady = ([] for _ in range(8))
     shapes, stopped_by, failure, eigen = None, None, None, []
+    path = SpeedPath() if continued else None
     for speed in speeds:
         try:
-            steady.append(solve_steady(frame, speed, steps=steps, options=options))
+            steady.append(solve_steady(frame, speed, steps, options, path=path))
             if on_speed:
                 on_speed(len(steady), speed)
             modes = solve_rotating_modes(frame, n_modes + extra_modes, options=options)
@@ -82,12 +106,7 @@ def campbell(
                 log(f"  {speed:.6g} rad/s: {str(e).splitlines()[0]}")
             steady = steady[: len(done)]
             break
-        if shapes is None:
-            order, mac = np.arange(n_modes), np.ones(n_modes)
-        else:
-            M = assemble_mass(frame)
-            order, mac = track(shapes, modes.vectors, M)
-            M.destroy()
+        order, mac = _follow(frame, shapes, modes, n_modes)
         shapes = [modes.vectors[i] for i in order]
         eigen.append(modes.seconds)
         done.append(speed)

@@ -30,8 +30,8 @@ from ..solvers.forms import compile_form
 from ..solvers.quadratic import solve_quadratic
 from .dofs import owned_size, subspace_dofs
 from .modal import mass_ufl
+from .rotating_path import solve_steady  # noqa: F401  (re-exported: its home is rotating_path)
 from .section_fields import offset_inertia
-from .static import StaticResult, load_scale, solve_static
 
 ROTARY = ("full", "none")
 
@@ -149,46 +149,6 @@ class RotatingFrame:
             m = self.model
             self._newton[key] = NewtonSolver(self.F, self.J, m.w, m.bcs, prefix, options)
         return self._newton[key]
-
-
-def solve_steady(frame, speed, steps=10, options=None, prefix="beamfx_rotating_static_", log=None):
-    """The relative equilibrium at ``speed`` (rad/s), from the undeformed state by load steps in
-    Ω² (adaptive, as :func:`~beamfx.analyses.static.solve_static`). Leaves the model at load
-    factor 1.
-
-    Raises:
-        NoSteadyState: past a divergence speed, where no steady state is left: the state
-            reached has a folded centre line (axial stretch ≤ 0 somewhere), or Newton failed
-            and the tangent loses definiteness by this speed
-            (:func:`~beamfx.analyses.rotating_checks.steady_state_lost`). For a linear-elastic
-            radial rod the centrifugal stretch grows without bound as Ω → (π/2) sqrt(E/ρ)/L,
-            and past it the load steps can jump to a folded, unstable solution.
-        SolveFailed: Newton failed with the tangent positive definite (numerical).
-    """
-    from ..solvers.snes import SolveFailed
-    from .rotating_checks import NoSteadyState, classify_failure
-
-    model = frame.model
-    frame.set_speed(speed)
-    model.reset()
-    model.set_load_factor(0.0)
-    solver = frame.newton(prefix, options)
-    if load_scale(model, solver.F) == 0.0:  # at rest and unloaded: the reference state (Newton
-        model.set_load_factor(1.0)  # could not reach an absolute tolerance of 0)
-        return StaticResult((), 0, {"total": 0.0})
-    try:
-        result = solve_static(model, steps=steps, solver=solver, log=log)
-    except SolveFailed as e:
-        raise classify_failure(frame, e) from None
-    stretch = frame.min_stretch()
-    if stretch <= 0:
-        raise NoSteadyState(
-            f"no steady state at {speed:.6g} rad/s: the equilibrium found has a folded centre "
-            f"line (smallest axial stretch {stretch:.3g}); the speed is past a divergence",
-            result.steps,
-            "no steady state",
-        )
-    return result
 
 
 class RotatingModes(NamedTuple):

@@ -41,31 +41,50 @@ def lowest_tangent_eigenvalue(frame, prefix="beamfx_rotating_check_"):
     return float(pairs.values[0].real)
 
 
-def steady_state_lost(frame, lam_last):
-    """(lost, why) after a failed Ω² ramp whose last converged load factor is ``lam_last`` (the
-    model holds that state). The model is left as it was."""
+def steady_state_lost(frame, lam_last, speed_last=None):
+    """(lost, why) after a failed solve of the steady state at the frame's speed Ω whose last
+    converged state (the model holds it) is at load factor ``lam_last`` and speed
+    ``speed_last`` (default Ω: the ramp from rest; a continuation from a previous speed has
+    load factor 1). μ is extrapolated in the share of Ω² reached, lam_last·(speed_last/Ω)².
+    The model and the frame are left as they were."""
     model, speed = frame.model, frame.speed
+    speed_last = speed if speed_last is None else speed_last
     saved, lam_now = model.w.x.array.copy(), float(model.load_factor.value)
+    frame.set_speed(speed_last)
     model.set_load_factor(lam_last)
     mu_last = lowest_tangent_eigenvalue(frame)
+    frame.set_speed(speed)
     model.reset()
     model.set_load_factor(0.0)
     mu_0 = lowest_tangent_eigenvalue(frame)
     model.w.x.array[:] = saved
     model.w.x.scatter_forward()
     model.set_load_factor(lam_now)
-    at = f"{np.sqrt(lam_last) * speed:.6g} rad/s"
+    share = lam_last * (speed_last / speed) ** 2 if speed != 0 else 0.0
+    at = f"{np.sqrt(share) * abs(speed):.6g} rad/s"
     numbers = f"lowest tangent eigenvalue {mu_0:.4g} at rest, {mu_last:.4g} at {at}"
     if mu_last <= 0:
         return True, f"the tangent is not positive definite at {at} ({numbers})"
-    if lam_last > 0 and mu_last < mu_0:
-        lam_zero = lam_last * mu_0 / (mu_0 - mu_last)
+    if share > 0 and mu_last < mu_0:
+        lam_zero = share * mu_0 / (mu_0 - mu_last)
         if lam_zero <= 1.0:
             return True, (
-                f"the tangent loses definiteness near {np.sqrt(lam_zero) * speed:.6g} rad/s, "
-                f"below the asked speed ({numbers}; extrapolated in Ω²)"
+                f"the tangent loses definiteness near {np.sqrt(lam_zero) * abs(speed):.6g} "
+                f"rad/s, below the asked speed ({numbers}; extrapolated in Ω²)"
             )
     return False, f"the tangent stays positive definite ({numbers})"
+
+
+def speed_of_failure(frame, error):
+    """(load factor, speed) of the last converged state of a failed steady-state solve: that
+    of a continuation (loads at full, ``details["speed_rad_s"]``:
+    :func:`~beamfx.analyses.rotating_path.continue_steady`), else of the ramp from the
+    undeformed state at the frame's speed."""
+    details = getattr(error, "details", None) or {}
+    if "speed_rad_s" in details:
+        return 1.0, float(details["speed_rad_s"])
+    steps = getattr(error, "history", ())
+    return (steps[-1].load_factor if steps else 0.0), frame.speed
 
 
 def classify_failure(frame, error):
@@ -73,8 +92,7 @@ def classify_failure(frame, error):
     :class:`NoSteadyState` if :func:`steady_state_lost`, else ``error`` (a numerical failure)
     with the tangent's verdict added to its message and details."""
     steps = getattr(error, "history", ())
-    lam_last = steps[-1].load_factor if steps else 0.0
-    lost, why = steady_state_lost(frame, lam_last)
+    lost, why = steady_state_lost(frame, *speed_of_failure(frame, error))
     speed = f"{frame.speed:.6g} rad/s"
     if lost:
         return NoSteadyState(f"no steady state at {speed}: {why}", steps, "no steady state")

@@ -76,6 +76,11 @@ def _buckling_solve(model_spec, n_modes=1):
 
     model = BeamModel(model_spec)
     r = solve_buckling(model, n_modes=n_modes, prefix="beamfx_bench_buckling_")
+    if len(r.load_factors) < n_modes:
+        raise RuntimeError(
+            f"buckling: {len(r.load_factors)} of {n_modes} real positive load factors found "
+            "(the other roots are complex beyond round-off, buckling.is_real, or negative)"
+        )
     return r.load_factors, model.unknowns()
 
 

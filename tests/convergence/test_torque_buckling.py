@@ -149,3 +149,27 @@ def test_quasitangential_load_needs_an_arm_normal_to_its_moment():
         with pytest.raises(SceneError) as e:
             scene(extra)
         assert str(e.value).startswith(message), str(e.value)
+
+
+def test_a_double_root_split_by_round_off_is_taken_as_real():
+    """EA and GA ×1e4 (the stress matrix): the semitangential shaft's double root (two bending
+    planes) comes out of the unsymmetric solve as μ ± 1e-4 i (|Im μ|/|μ| = 2e-8, above the
+    former 1e-8 test; its residual 3e-7), so no root was kept and the bench case raised an
+    IndexError. It is real to its own residual (buckling.is_real): M_cr is the one at ×1 to
+    1e-6 (the matrix's tolerance; the stiffening moves it by ~1e-7)."""
+    from beamfx.bench.stress_matrix import stiffened
+
+    at_1 = critical(4, 3, "semitangential")
+    with stiffened(1e4):
+        stiff = critical(4, 3, "semitangential")
+    assert stiff == pytest.approx(at_1, rel=1e-6)
+
+
+def test_real_roots_are_told_from_complex_ones_by_their_residual():
+    from beamfx.analyses.buckling import REAL_CAP, is_real
+
+    assert is_real(5181.55 + 9.94e-5j, 3e-7)  # round-off within the residual
+    assert not is_real(5181.55 + 9.94e-5j, 1e-12)  # a converged root: 1e-8 holds
+    assert is_real(5181.55 + 4e-5j, 0.0)
+    assert not is_real(5000.0 + 10.0j, 1.0)  # an unconverged complex root: capped
+    assert not is_real(5000.0 + 5000.0 * 2 * REAL_CAP * 1j, 1.0)
