@@ -9,6 +9,10 @@
 * What (:func:`clear_earlier_run`): a fresh run removes the files an earlier run wrote there
   (frames, series, probes, results, checkpoints, pictures; only names beamfx writes); a
   restart keeps them (the series and probes are cut back to the checkpoint by the analysis).
+  An earlier run's frame files are left for the new frames of the same name to overwrite in
+  place, and those the new run did not write are removed when it ends
+  (:func:`remove_unwritten`): creating a file after its unlink cost 1-2 ms on the machine of
+  the benchmarks, writing over it in place 13 µs (the spin-up writes 207 frames).
 """
 
 import json
@@ -32,6 +36,9 @@ RUN_FILES = re.compile(
     r"|undeformed\.vtu|deformed\.png|mode_\d+\.png|animation\.gif"
     r"|checkpoint_\d+ranks_\d+\.npz|\.checkpoint_\d+ranks_\d+\.\d+\.tmp\.npz|\.tmp-.*\.json)"
 )
+
+#: the frame files among them (:mod:`beamfx.io.series`), overwritten in place by a new run
+FRAME_FILES = re.compile(r"(deformed|surface)_\d{4,}(_\d+)?\.(vtu|pvtu)")
 
 
 class FolderError(OSError):
@@ -170,15 +177,41 @@ def release(path):
 
 def clear_earlier_run(folder, restart):
     """Remove what an earlier run wrote in ``folder`` (only names beamfx writes, listed by
-    :data:`RUN_FILES`); on a restart only its ``results.json``. Returns the names removed."""
+    :data:`RUN_FILES`); on a restart only its ``results.json``. Frame files
+    (:data:`FRAME_FILES`) are kept for the new run to overwrite: returns (the names removed,
+    ``{frame file name: its stat signature}``) for :func:`remove_unwritten`."""
     folder = Path(folder)
     names = ["results.json"] if restart else sorted(os.listdir(folder))
-    removed = []
+    removed, frames = [], {}
     for name in names:
         path = folder / name
         if RUN_FILES.fullmatch(name) and path.is_file() and not path.is_symlink():
+            if FRAME_FILES.fullmatch(name):
+                frames[name] = _signature(path)
+                continue
             path.unlink()
             removed.append(name)
+    return removed, frames
+
+
+def _signature(path):
+    """What changes when a file is written again: inode, size and modification time."""
+    st = os.stat(path)
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
+def remove_unwritten(folder, frames):
+    """Remove the earlier run's frame files ``frames`` (from :func:`clear_earlier_run`) that
+    this run did not write again (their stat signature is unchanged). Returns their names."""
+    removed = []
+    for name, signature in frames.items():
+        path = Path(folder) / name
+        try:
+            if _signature(path) == signature:
+                path.unlink()
+                removed.append(name)
+        except FileNotFoundError:
+            pass
     return removed
 
 
@@ -186,13 +219,17 @@ def clear_earlier_run(folder, restart):
 def claim(folder, comm, scene, restart=False, log=None):
     """Hold ``folder`` for one run: locked, cleared of an earlier run's files (rank 0), the
     lock released at the end. Collective: every rank raises the same :class:`FolderError`."""
-    lock, error = None, None
+    lock, error, frames = None, None, {}
     if comm.rank == 0:
         try:
             lock = acquire(folder, scene, log)
-            removed = clear_earlier_run(folder, restart)
-            if removed and log and not restart:
-                log(f"note: {folder}: removed {len(removed)} file(s) of an earlier run")
+            removed, frames = clear_earlier_run(folder, restart)
+            if (removed or frames) and log and not restart:
+                log(
+                    f"note: {folder}: removed {len(removed)} file(s) of an earlier run; its "
+                    f"{len(frames)} frame file(s) are overwritten by this run's (the others "
+                    "removed at its end)"
+                )
         except OSError as e:
             error = str(e)
     error = comm.bcast(error, root=0) if comm.size > 1 else error
@@ -202,6 +239,10 @@ def claim(folder, comm, scene, restart=False, log=None):
         raise FolderError(error)
     try:
         yield
+        if frames or comm.size > 1:  # every rank's frames written before rank 0 looks
+            comm.barrier()
+        if frames:
+            remove_unwritten(folder, frames)
     except BaseException as e:  # interrupted by a signal: say so in results.json
         from ..interrupt import interruption
         from .results import write_json_atomic
@@ -225,5 +266,6 @@ __all__ = [
     "claim",
     "clear_earlier_run",
     "release",
+    "remove_unwritten",
     "system_folder",
 ]

@@ -110,6 +110,8 @@ def compile_expression(text, variable, constants=None):
                 y = eval(code, scope, {variable: x})
         except (OverflowError, ZeroDivisionError) as e:  # float arithmetic of constants
             raise ValueError(f"{_quote(text)}: {e}") from None
+        if not x.ndim:  # one value (a history at a time step): the same 0-d array, cheaper
+            return np.array(y, dtype=float)
         return np.broadcast_to(y, x.shape).astype(float)
 
     f.text = text

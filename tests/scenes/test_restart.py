@@ -236,6 +236,9 @@ def test_a_fresh_run_removes_the_files_of_an_earlier_run(tmp_path, capsys):
     stale += ["checkpoint_2ranks_1.npz", "results.json", "mode_03.png"]
     for name in [*stale, "notes.txt", "deformed_final.vtu"]:
         (out / name).write_text("an earlier run")
+    rewritten = out / "deformed_0001.vtu"  # a frame of the new run too: overwritten in place
+    rewritten.write_bytes(b"an earlier, longer frame " * 4000)
+    inode = rewritten.stat().st_ino
     (tmp_path / "spin.toml").write_text(SPIN.replace("t_end = 1.2", "t_end = 0.01"))
     cwd = os.getcwd()
     os.chdir(tmp_path)
@@ -246,6 +249,11 @@ def test_a_fresh_run_removes_the_files_of_an_earlier_run(tmp_path, capsys):
     left = {p.name for p in out.iterdir()}
     assert not left & (set(stale) - {"results.json", "probes.jsonl"})  # written anew
     assert {"notes.txt", "deformed_final.vtu"} <= left  # not names beamfx writes
-    assert "removed 7 file(s) of an earlier run" in capsys.readouterr().out
+    # the frame files are kept for this run to overwrite in place; those it did not write
+    # again (the three numbered 0999, 0003 and 0007 here) are removed at its end (checked above)
+    assert "removed 4 file(s) of an earlier run; its 4 frame file(s)" in capsys.readouterr().out
+    frame = rewritten.read_bytes()
+    assert rewritten.stat().st_ino == inode and frame.endswith(b"</VTKFile>\n")  # cut to length
+    assert b"earlier" not in frame
     assert json.loads((out / "results.json").read_text())["status"] == "converged"
     assert Path(out / "probes.csv").read_text().count("\n") == 4  # header, t = 0 and 2 steps
