@@ -125,14 +125,16 @@ def evaluate(model, points, cells, recover=True, full=True):
 
 def section_evaluator(model, points, recover=True):
     """(compiled expression, layout, its points as a tuple) of the module table at reference
-    ``points`` (flat), followed by the Gauss points with ``recover``: compiled once per model
+    ``points`` (flat), followed by the Gauss points (read with ``recover``): compiled once per model
     and points (collective then), afterwards a look-up. Its ``eval(cells)`` gives, per cell,
     every point's quantities in a row of the layout's size."""
     from dolfinx import fem
 
     points = np.asarray(points, dtype=float).reshape(-1)
-    gauss = gauss_points(model.degree)
-    sample = np.concatenate([points, gauss]) if recover else points
+    # the Gauss points even without ``recover`` (whose values are then not read): one
+    # compiled expression serves both (a second costs a few ms of every run: UFL signature,
+    # FFCx and DOLFINx set-up), and the values at ``points`` come out the same
+    sample = np.concatenate([points, gauss_points(model.degree)])
     key = tuple(sample.tolist())
     per_model = _compiled.setdefault(model, {})
     if key not in per_model:

@@ -34,8 +34,8 @@ def write_json_atomic(path, obj, comm=MPI.COMM_WORLD, indent=1):
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".json", dir=folder)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(obj, f, indent=indent, default=_plain)
-            f.write("\n")
+            # one write of the whole text (json.dump writes each of its many pieces)
+            f.write(json.dumps(obj, indent=indent, default=_plain) + "\n")
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
