@@ -148,3 +148,23 @@ def test_a_loaded_jit_module_is_answered_from_memory():
     assert names, "the form's module is remembered"
     second = compile_form(form)
     assert first.ufcx_form == second.ufcx_form
+
+
+def test_ffcx_parameter_log_reads_the_same_when_shown(caplog, monkeypatch):
+    """The FFCx parameter dump is formatted only when shown, and then as pprint formats it."""
+    import logging
+    import pprint
+
+    import ffcx.parameters
+
+    from beamfx.solvers.forms import remember_loaded_modules
+
+    remember_loaded_modules()
+    calls, pformat = [], pprint.pformat
+    monkeypatch.setattr(pprint, "pformat", lambda *a, **k: calls.append(1) or pformat(*a, **k))
+    ffcx.parameters.get_parameters()  # FFCx's default verbosity (WARNING): not shown
+    assert not calls
+    with caplog.at_level(logging.INFO, logger="ffcx"):
+        params = ffcx.parameters.get_parameters({"verbosity": logging.INFO})
+    assert pprint.pformat(params) in [r.getMessage() for r in caplog.records]
+    ffcx.parameters.get_parameters()  # back to FFCx's default verbosity (WARNING)
