@@ -178,25 +178,27 @@ def release(path):
 def clear_earlier_run(folder, restart):
     """Remove what an earlier run wrote in ``folder`` (only names beamfx writes, listed by
     :data:`RUN_FILES`); on a restart only its ``results.json``. Frame files
-    (:data:`FRAME_FILES`) are kept for the new run to overwrite: returns (the names removed,
-    ``{frame file name: its stat signature}``) for :func:`remove_unwritten`."""
+    (:data:`FRAME_FILES`) are kept for the new run to overwrite in place, unless another name
+    links to the same file (a copy made with ``cp -l`` would change with them): returns (the
+    names removed, ``{frame file name: its stat signature}``) for :func:`remove_unwritten`."""
     folder = Path(folder)
     names = ["results.json"] if restart else sorted(os.listdir(folder))
     removed, frames = [], {}
     for name in names:
         path = folder / name
         if RUN_FILES.fullmatch(name) and path.is_file() and not path.is_symlink():
-            if FRAME_FILES.fullmatch(name):
-                frames[name] = _signature(path)
+            st = path.stat()
+            if FRAME_FILES.fullmatch(name) and st.st_nlink == 1:  # a hard link: not in place
+                frames[name] = _signature(st)
                 continue
             path.unlink()
             removed.append(name)
     return removed, frames
 
 
-def _signature(path):
-    """What changes when a file is written again: inode, size and modification time."""
-    st = os.stat(path)
+def _signature(st):
+    """What changes when a file is written again (of its ``os.stat``): inode, size and
+    modification time."""
     return st.st_ino, st.st_size, st.st_mtime_ns
 
 
@@ -207,7 +209,7 @@ def remove_unwritten(folder, frames):
     for name, signature in frames.items():
         path = Path(folder) / name
         try:
-            if _signature(path) == signature:
+            if _signature(path.stat()) == signature:
                 path.unlink()
                 removed.append(name)
         except FileNotFoundError:

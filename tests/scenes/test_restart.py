@@ -239,6 +239,9 @@ def test_a_fresh_run_removes_the_files_of_an_earlier_run(tmp_path, capsys):
     rewritten = out / "deformed_0001.vtu"  # a frame of the new run too: overwritten in place
     rewritten.write_bytes(b"an earlier, longer frame " * 4000)
     inode = rewritten.stat().st_ino
+    linked = out / "deformed_0002.vtu"  # also a frame, but linked from elsewhere: replaced
+    linked.write_text("an earlier run, kept elsewhere")
+    os.link(linked, tmp_path / "kept.vtu")
     (tmp_path / "spin.toml").write_text(SPIN.replace("t_end = 1.2", "t_end = 0.01"))
     cwd = os.getcwd()
     os.chdir(tmp_path)
@@ -251,7 +254,9 @@ def test_a_fresh_run_removes_the_files_of_an_earlier_run(tmp_path, capsys):
     assert {"notes.txt", "deformed_final.vtu"} <= left  # not names beamfx writes
     # the frame files are kept for this run to overwrite in place; those it did not write
     # again (the three numbered 0999, 0003 and 0007 here) are removed at its end (checked above)
-    assert "removed 4 file(s) of an earlier run; its 4 frame file(s)" in capsys.readouterr().out
+    assert "removed 5 file(s) of an earlier run; its 4 frame file(s)" in capsys.readouterr().out
+    assert (tmp_path / "kept.vtu").read_text() == "an earlier run, kept elsewhere"
+    assert linked.read_bytes().endswith(b"</VTKFile>\n")
     frame = rewritten.read_bytes()
     assert rewritten.stat().st_ino == inode and frame.endswith(b"</VTKFile>\n")  # cut to length
     assert b"earlier" not in frame
