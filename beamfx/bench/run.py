@@ -160,6 +160,7 @@ def run_case(case, log=print):
         "paper": case.paper,
         "title": case.title,
         "note": case.note,
+        "own_model": case.own_model,
         "reference": {k: float(v) for k, v in ref.items()},
         "reference_is_finest_setting": ref_is_finest,
         "tolerance": case.tolerance,
