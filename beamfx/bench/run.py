@@ -192,6 +192,7 @@ def _s(row, key):
 
 def _case_lines(r, figures):
     """The report section of one case: reference, table of settings, profile, orders."""
+    from .model_choice import case_model_line
     from .profiling import case_lines, iteration_line
 
     lines = []
@@ -200,6 +201,8 @@ def _case_lines(r, figures):
         f"## {r['id']}: {r['title']}",
         "",
         f"*{r['paper']}.* {r['note']}",
+        "",
+        case_model_line(r),
         "",
         *(
             [f"![{r['id']}: convergence and cost]({figures[r['id']]})", ""]
@@ -267,6 +270,8 @@ def _case_lines(r, figures):
 def markdown(results, figures=None, note=None):
     """The report; ``figures`` maps case ids (and "summary") to PNG files beside it, ``note``
     says why there are none."""
+    from .model_choice import intro_lines, model_cell
+
     figures = figures or {}
     lines = [
         "# beamfx validation report",
@@ -297,6 +302,7 @@ def markdown(results, figures=None, note=None):
             "up to 10^4 frames and in whole runs, [output_cost.md](output_cost.md) "
             "(`python -m beamfx.bench.output_cost`)."
         ),
+        *intro_lines(),
         "",
     ]
     if note:
@@ -308,10 +314,10 @@ def markdown(results, figures=None, note=None):
         ]
     lines += [
         (
-            "| case | passed | cheapest within tolerance | error | unknowns | whole run s | "
-            "process s | solve only s |"
+            "| case | passed | cheapest within tolerance | model | error | unknowns | "
+            "whole run s | process s | solve only s |"
         ),
-        "|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         c = r["cheapest_within_tolerance"]
@@ -319,10 +325,11 @@ def markdown(results, figures=None, note=None):
         lines.append(
             f"| {r['id']}{star} | {'yes' if r['passed'] else 'NO'} | "
             + (
-                f"{c['elements']} x P{c['degree']} | {c['error']:.2e} | {c['unknowns']} | "
-                f"{_s(c, 'wall_s_whole')} | {_s(c, 'wall_s_process')} | {c['wall_s_warm']:.3f} |"
+                f"{c['elements']} x P{c['degree']} | {model_cell(r, c)} | {c['error']:.2e} | "
+                f"{c['unknowns']} | {_s(c, 'wall_s_whole')} | {_s(c, 'wall_s_process')} | "
+                f"{c['wall_s_warm']:.3f} |"
                 if c
-                else "- | - | - | - | - | - |"
+                else f"- | {model_cell(r, r['rows'][-1] if r['rows'] else None)} | - | - | - | - | - |"
             )
         )
     from .profiling import profile_lines
