@@ -55,17 +55,21 @@ def intro_lines():
     return lines
 
 
+def _kind(row):
+    """The model that solved a row: its formulation (or an adaptive row's model), or None."""
+    return (row or {}).get("formulation") or (row or {}).get("model")
+
+
 def model_cell(r, row):
-    """The summary table's model of a case at ``row``: the formulation that solved it, and
+    """The summary table's model of a case at ``row``: the formulation that solved it, or
     "own" where the case times a model of its own."""
-    name = (row or {}).get("formulation") or (row or {}).get("model") or "-"
-    return f"{name}, own" if r.get("own_model") else name
+    return "own" if r.get("own_model") else _kind(row) or "-"
 
 
 def case_model_line(r):
     """A case section's line on its model: the scene builder's pick, or the case's own and
     why."""
-    kinds = list(dict.fromkeys(row["formulation"] for row in r["rows"] if "formulation" in row))
+    kinds = list(dict.fromkeys(_kind(row) for row in r["rows"] if _kind(row)))
     if r.get("own_model"):
         return f"Model: its own, not the scene builder's pick: {r['own_model']}."
     solved = f" ({', '.join(kinds)})" if kinds else ""

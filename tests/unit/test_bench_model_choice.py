@@ -81,3 +81,17 @@ def test_the_elastica_case_gets_the_scene_files_model(k):
     assert user.model.kinematics.plane == "xz" and user.condense  # planar condensed
     assert bench.model == user.model
     assert (bench.trimming, bench.condense) == (user.trimming, user.condense)
+
+
+def test_the_report_names_each_cases_model_and_why_a_case_keeps_its_own():
+    from beamfx.bench.model_choice import MOVED, case_model_line, model_cell
+
+    rows = [{"formulation": "planar condensed"}, {"formulation": "planar condensed"}]
+    assert model_cell({"own_model": ""}, rows[0]) == "planar condensed"
+    assert model_cell({"own_model": "it compares two models"}, rows[0]) == "own"
+    line = case_model_line({"own_model": "it compares two models", "rows": rows})
+    assert "it compares two models" in line
+    assert case_model_line({"own_model": "", "rows": rows}).endswith("(planar condensed).")
+    named = {name for cases, *_ in MOVED for name in cases.split(", ")}
+    assert named <= set(CASES)  # the intro's table names registered cases only
+    assert not any(CASES[name].own_model for name in named)
