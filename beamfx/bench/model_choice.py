@@ -55,6 +55,14 @@ def intro_lines():
     return lines
 
 
+def formulation(entry):
+    """What solved a run, from its results.json ``model`` entry: "planar condensed",
+    "condensed", "planar" or "full"."""
+    if entry.get("condensed"):
+        return "planar condensed" if entry.get("plane") else "condensed"
+    return "planar" if entry.get("plane") else "full"
+
+
 def _kind(row):
     """The model that solved a row: its formulation (or an adaptive row's model), or None."""
     return (row or {}).get("formulation") or (row or {}).get("model")

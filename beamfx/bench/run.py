@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .model_choice import formulation
 from .profiling import newton_seconds, per_iteration
 
 
@@ -55,14 +56,6 @@ def run_setting(case, elements, degree):
         "values": {k: float(v) for k, v in case.measure(run.probes).items()},
         "path": [{k: float(v) for k, v in p.items()} for p in path],
     }
-
-
-def formulation(entry):
-    """What solved a run, from its results.json ``model`` entry: "planar condensed",
-    "condensed", "planar" or "full"."""
-    if entry.get("condensed"):
-        return "planar condensed" if entry.get("plane") else "condensed"
-    return "planar" if entry.get("plane") else "full"
 
 
 def _model_of(scene, case):

@@ -99,7 +99,7 @@ class SceneCase(Case):
         import tempfile
 
         from ..solvers.forms import compile_seconds
-        from .run import formulation
+        from .model_choice import formulation
 
         c0 = compile_seconds[0]
         with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:

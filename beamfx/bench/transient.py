@@ -127,8 +127,8 @@ class TransientCase(Case):
 
         from ..analyses.model import BeamModel
         from ..solvers.forms import compile_seconds
+        from .model_choice import formulation
         from .profiling import newton_seconds, per_iteration, stack_limits
-        from .run import formulation
         from .scenes import run_in_process
 
         scene = self.scene(elements, degree, dt, *scheme)
