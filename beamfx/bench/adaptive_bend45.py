@@ -38,17 +38,17 @@ def _converged(follower):
 
 
 def _scene(spec, steps, elements, degree, tolerance):
-    """The scene of a setting, with its ``[accuracy]`` and the model the scene builder picks."""
+    """The scene of a setting, with its ``[accuracy]`` and the model the scene builder picks
+    (:func:`~beamfx.bench.scenes.chosen_model`)."""
     from ..analyses import static_run
-    from ..analyses.trimming import condensed_fit
     from ..scene.load import Scene
+    from .scenes import chosen_model
 
-    return Scene(
+    scene = Scene(
         "bench",
         spec,
         settings=static_run.Settings(steps=steps),
         probes={"tip": "b:end"},
-        condense=condensed_fit(spec) is None,  # as the scene builder decides
         accuracy={
             "quantity": "tip.position",
             "tolerance": tolerance,
@@ -59,6 +59,7 @@ def _scene(spec, steps, elements, degree, tolerance):
             "max_unknowns": 2000,
         },
     )
+    return chosen_model(scene)
 
 
 def _refine(scene):
@@ -125,11 +126,16 @@ def _accuracy(ref, tolerance, follower, per_node):
 class AdaptiveCase(Case):
     """Settings are (start elements, start degree, tolerance)."""
 
+    def scene(self, elements, degree, tolerance):
+        """The scene of a setting: its ``[accuracy]`` and the model the scene builder picks."""
+        spec, steps = self.build(elements, degree)
+        return _scene(spec, steps, elements, degree, tolerance)
+
     def run_setting(self, elements, degree, tolerance):
         """One row of the table: the adaptive refinement from the setting, its value and costs."""
         follower = self.extra["follower"]
-        spec, steps = self.build(elements, degree)
-        scene = _scene(spec, steps, elements, degree, tolerance)
+        scene = self.scene(elements, degree, tolerance)
+        steps = scene.steps
         ref, model, cold = _refine(scene)
         warm, warm_s = _warm_solve(model, steps)
         per_node = 3 if scene.condense else 7  # unknowns of the clamped node

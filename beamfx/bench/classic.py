@@ -51,7 +51,6 @@ for lam in ROLL["spec"]["lambda_values"]:
             "scene builder picks the planar statically condensed model (a plane cantilever "
             "under an end moment): the angle, linear in s, is exact on any mesh and the centre "
             "line is integrated in closed form, so one P1 element is exact to round-off.",
-            choose_model=True,
         )
     )
 

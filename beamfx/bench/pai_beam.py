@@ -423,6 +423,9 @@ register(
         tolerance=1e-3,
         scale=1.0,
         settings=((5, 3, 0.005), (5, 3, 0.0025), (5, 3, 0.00125)),
+        own_model="its own solver path (free decays from the gravity-loaded state started "
+        "with a mode-2 velocity field, read from the solver's history), not a scene; the "
+        "model is the planar (xy) one, built so",
         note=(
             "Planar model, gravity along the upright beam, a1 = 5e-5 s stiffness-proportional "
             "damping. Free decays from the gravity-loaded state with a mode-2 velocity field; "

@@ -104,5 +104,7 @@ register(
         scale=L,
         note="A planar case solved with 3/7 of the unknowns of the full model and the same "
         "answer (to the discretisation error); error relative to L, of the planar model.",
+        own_model="it compares the planar model with the full one on purpose; the scene "
+        "builder would pick the planar condensed model (as for the rollup_* cases)",
     )
 )

@@ -47,9 +47,11 @@ class Case:
     scale: float | None = None  # error = max |value - ref| / scale (None: relative per value)
     note: str = ""
     extra: dict = field(default_factory=dict)
-    #: the scene builder picks the model as for a scene file (planar, statically condensed:
-    #: :func:`beamfx.scene.load.choose_model`); False: the case's model as built
-    choose_model: bool = False
+    #: empty (the default): every scene of the case gets the model the scene builder picks
+    #: for a user's scene file (planar, statically condensed:
+    #: :func:`beamfx.scene.load.choose_model`), so its times are the times of ``beamfx run``.
+    #: An opt-out says here why the case times a model of its own instead (the report prints it)
+    own_model: str = ""
 
 
 REGISTRY: dict[str, Case] = {}

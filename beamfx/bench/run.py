@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .model_choice import formulation
 from .profiling import newton_seconds, per_iteration
 
 
@@ -55,14 +56,6 @@ def run_setting(case, elements, degree):
         "values": {k: float(v) for k, v in case.measure(run.probes).items()},
         "path": [{k: float(v) for k, v in p.items()} for p in path],
     }
-
-
-def formulation(entry):
-    """What solved a run, from its results.json ``model`` entry: "planar condensed",
-    "condensed", "planar" or "full"."""
-    if entry.get("condensed"):
-        return "planar condensed" if entry.get("plane") else "condensed"
-    return "planar" if entry.get("plane") else "full"
 
 
 def _model_of(scene, case):
@@ -160,6 +153,7 @@ def run_case(case, log=print):
         "paper": case.paper,
         "title": case.title,
         "note": case.note,
+        "own_model": case.own_model,
         "reference": {k: float(v) for k, v in ref.items()},
         "reference_is_finest_setting": ref_is_finest,
         "tolerance": case.tolerance,
@@ -191,6 +185,7 @@ def _s(row, key):
 
 def _case_lines(r, figures):
     """The report section of one case: reference, table of settings, profile, orders."""
+    from .model_choice import case_model_line
     from .profiling import case_lines, iteration_line
 
     lines = []
@@ -199,6 +194,8 @@ def _case_lines(r, figures):
         f"## {r['id']}: {r['title']}",
         "",
         f"*{r['paper']}.* {r['note']}",
+        "",
+        case_model_line(r),
         "",
         *(
             [f"![{r['id']}: convergence and cost]({figures[r['id']]})", ""]
@@ -266,6 +263,8 @@ def _case_lines(r, figures):
 def markdown(results, figures=None, note=None):
     """The report; ``figures`` maps case ids (and "summary") to PNG files beside it, ``note``
     says why there are none."""
+    from .model_choice import intro_lines, model_cell
+
     figures = figures or {}
     lines = [
         "# beamfx validation report",
@@ -296,6 +295,7 @@ def markdown(results, figures=None, note=None):
             "up to 10^4 frames and in whole runs, [output_cost.md](output_cost.md) "
             "(`python -m beamfx.bench.output_cost`)."
         ),
+        *intro_lines(),
         "",
     ]
     if note:
@@ -307,10 +307,10 @@ def markdown(results, figures=None, note=None):
         ]
     lines += [
         (
-            "| case | passed | cheapest within tolerance | error | unknowns | whole run s | "
-            "process s | solve only s |"
+            "| case | passed | cheapest within tolerance | model | error | unknowns | "
+            "whole run s | process s | solve only s |"
         ),
-        "|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         c = r["cheapest_within_tolerance"]
@@ -318,10 +318,11 @@ def markdown(results, figures=None, note=None):
         lines.append(
             f"| {r['id']}{star} | {'yes' if r['passed'] else 'NO'} | "
             + (
-                f"{c['elements']} x P{c['degree']} | {c['error']:.2e} | {c['unknowns']} | "
-                f"{_s(c, 'wall_s_whole')} | {_s(c, 'wall_s_process')} | {c['wall_s_warm']:.3f} |"
+                f"{c['elements']} x P{c['degree']} | {model_cell(r, c)} | {c['error']:.2e} | "
+                f"{c['unknowns']} | {_s(c, 'wall_s_whole')} | {_s(c, 'wall_s_process')} | "
+                f"{c['wall_s_warm']:.3f} |"
                 if c
-                else "- | - | - | - | - | - |"
+                else f"- | {model_cell(r, r['rows'][-1] if r['rows'] else None)} | - | - | - | - | - |"
             )
         )
     from .profiling import profile_lines

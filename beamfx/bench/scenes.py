@@ -13,13 +13,15 @@ def case_scene(case, elements, degree, analysis="static", **settings):
     spec, steps = case.build(elements, degree)
     if "steps" in {f.name for f in fields(lookup(analysis).settings)}:
         settings.setdefault("steps", steps)
-    scene = analysis_scene(case.id, spec, analysis, case.probes, **settings)
-    return chosen_model(scene) if case.choose_model else scene
+    return analysis_scene(
+        case.id, spec, analysis, case.probes, choose=not case.own_model, **settings
+    )
 
 
 def chosen_model(scene):
-    """``scene`` with the model the scene builder would pick for it from a file ([model]
-    plane and condense "auto": planar, statically condensed)."""
+    """``scene`` with the model the scene builder picks for it from a file ([model] plane and
+    condense "auto": planar, statically condensed), by the same
+    :func:`~beamfx.scene.load.choose_model` as ``beamfx run``."""
     from dataclasses import replace
 
     from ..analyses.registry import analysis as lookup
@@ -47,16 +49,18 @@ def run_in_process(scene, folder):
     return run, time.perf_counter() - t0
 
 
-def analysis_scene(case_id, spec, analysis, probes=None, **settings):
+def analysis_scene(case_id, spec, analysis, probes=None, choose=True, **settings):
     """A scene of ``analysis`` on the model ``spec`` with ``[analysis]`` ``settings``, as a
-    user's scene file of that model would give it."""
+    user's scene file of that model would give it: with the model the scene builder picks
+    (:func:`chosen_model`) unless ``choose`` is False (a case's documented ``own_model``)."""
     from ..analyses.registry import analysis as lookup
     from ..scene.load import Scene
 
     entry = lookup(analysis)
-    return Scene(
+    scene = Scene(
         f"bench:{case_id}", spec, analysis, dict(probes or {}), settings=entry.settings(**settings)
     )
+    return chosen_model(scene) if choose else scene
 
 
 def run_scenes(runs, folder):
@@ -95,6 +99,7 @@ class SceneCase(Case):
         import tempfile
 
         from ..solvers.forms import compile_seconds
+        from .model_choice import formulation
 
         c0 = compile_seconds[0]
         with tempfile.TemporaryDirectory(prefix="beamfx-bench-") as folder:
@@ -108,6 +113,7 @@ class SceneCase(Case):
             "elements": elements,
             "degree": degree,
             "unknowns": runs[0].model["unknowns"],
+            "formulation": " + ".join(dict.fromkeys(formulation(r.model) for r in runs)),
             "newton_iterations": sum(r.result.newton_iterations for r in runs),
             "load_steps": sum(len(r.result.load_steps) for r in runs),
             "wall_s_cold": cold,

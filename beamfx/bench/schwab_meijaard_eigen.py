@@ -40,6 +40,12 @@ class EigenCase(Case):
     """A case whose setting is an eigen analysis: ``build(elements, degree)`` returns
     ``(values, unknowns, newton_iterations)``; run by :meth:`run_setting` (cold, then warm)."""
 
+    own_model: str = (
+        "its own solver path (the eigen solves called directly: the shear and extension "
+        "extrapolation of 2.10, the torque kinds of 2.7), not a scene; the model is the full "
+        "one a scene gets, as buckling and rotating analyses are never trimmed or condensed"
+    )
+
     def run_setting(self, elements, degree):
         """One row of the table: the eigenvalues, unknowns and cold and warm wall times."""
         from ..solvers.forms import compile_seconds

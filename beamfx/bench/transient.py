@@ -110,12 +110,15 @@ class TransientCase(Case):
     series: object = None
 
     def scene(self, elements, degree, dt, *scheme):
-        """The scene of a setting, as ``beamfx run`` takes it (built in code)."""
+        """The scene of a setting, as ``beamfx run`` takes it (built in code), with the model
+        the scene builder picks (:func:`~beamfx.bench.scenes.chosen_model`)."""
         from ..scene.load import Scene
+        from .scenes import chosen_model
 
         spec, settings = self.build(elements, degree, dt, *scheme)
-        return Scene(f"bench:{self.id}", spec, "transient", dict(self.probes),
-                     settings=scene_settings(settings))  # fmt: skip
+        scene = Scene(f"bench:{self.id}", spec, "transient", dict(self.probes),
+                      settings=scene_settings(settings))  # fmt: skip
+        return scene if self.own_model else chosen_model(scene)
 
     def run_setting(self, elements, degree, dt, *scheme):
         """One row of the table: the measured values, unknowns, cold and warm whole runs and
@@ -124,6 +127,7 @@ class TransientCase(Case):
 
         from ..analyses.model import BeamModel
         from ..solvers.forms import compile_seconds
+        from .model_choice import formulation
         from .profiling import newton_seconds, per_iteration, stack_limits
         from .scenes import run_in_process
 
@@ -140,6 +144,7 @@ class TransientCase(Case):
             "degree": degree,
             "dt": dt,
             "unknowns": run.model["unknowns"],
+            "formulation": formulation(run.model),
             "newton_iterations": result.newton_iterations,
             "load_steps": result.time_steps,
             "wall_s_cold": cold,
