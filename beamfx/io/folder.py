@@ -177,13 +177,19 @@ def release(path):
 
 def clear_earlier_run(folder, restart):
     """Remove what an earlier run wrote in ``folder`` (only names beamfx writes, listed by
-    :data:`RUN_FILES`); on a restart only its ``results.json``. Frame files
+    :data:`RUN_FILES`); on a restart only its ``results.json``. A symbolic link with one of
+    those names is removed in both cases (the link, not what it points to: a run never writes
+    through a link, which could lead out of the folder). Frame files
     (:data:`FRAME_FILES`) are kept for the new run to overwrite in place, unless another name
     links to the same file (a copy made with ``cp -l`` would change with them): returns (the
     names removed, ``{frame file name: its stat signature}``) for :func:`remove_unwritten`."""
     folder = Path(folder)
-    names = ["results.json"] if restart else sorted(os.listdir(folder))
     removed, frames = [], {}
+    for name in sorted(os.listdir(folder)):  # a link never written through: the link goes
+        if RUN_FILES.fullmatch(name) and (folder / name).is_symlink():
+            (folder / name).unlink()
+            removed.append(name)
+    names = ["results.json"] if restart else sorted(os.listdir(folder))
     for name in names:
         path = folder / name
         if RUN_FILES.fullmatch(name) and path.is_file() and not path.is_symlink():

@@ -158,3 +158,26 @@ def test_scene_fingerprints_name_each_difference():
         "beams[0].elements: 8 in the checkpoint, 7 in the scene",
         "beams[0].section.EA: 1.0 in the checkpoint, 2.0 in the scene",
     ]
+
+
+def test_links_planted_in_the_output_folder_are_never_written_through(tmp_path):
+    """A folder from someone else with links named like beamfx's files (a frame, the probes,
+    the results) pointing out of it: the run replaces the links by its files and the targets
+    keep their content, on a fresh run and when a frame is written over in place."""
+    from beamfx.io.folder import clear_earlier_run
+    from beamfx.io.vtkfiles import write_in_place
+
+    outside = tmp_path / "outside.txt"
+    outside.write_text("keep me")
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("deformed_0001.vtu", "probes.csv", "results.json"):
+        (out / name).symlink_to(outside)
+    removed, frames = clear_earlier_run(out, restart=True)
+    assert sorted(removed) == ["deformed_0001.vtu", "probes.csv", "results.json"]
+    assert not any((out / n).exists() for n in removed) and frames == {}
+    (out / "deformed_0002.vtu").symlink_to(outside)  # planted after the clean-up
+    write_in_place(out / "deformed_0002.vtu", b"frame")
+    assert not (out / "deformed_0002.vtu").is_symlink()
+    assert (out / "deformed_0002.vtu").read_bytes() == b"frame"
+    assert outside.read_text() == "keep me"
