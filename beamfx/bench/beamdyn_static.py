@@ -19,8 +19,11 @@ openfast-io). Conventions, each checked:
   equal the applied load and its moment), beamfx's ``reactions`` the support's force on the
   beam: the bench compares BeamDyn's with minus beamfx's.
 
-The reference is BeamDyn's discretisation (one element of order 5, resp. 7), not an exact
-solution; the tolerances are estimates of its error (see each case's note), never fitted.
+BeamDyn's numbers are its discretisation's (one element of order 5, resp. 7), not exact
+solutions. The twisted case is scored against them, within how far BeamDyn agreed with ANSYS
+in the paper; the gravity cantilever against the exact beam (:mod:`.beamdyn_lsfe`), with
+BeamDyn's number and its estimated discretisation error beside it in the report. No
+tolerance is fitted to the result.
 """
 
 import math
@@ -46,15 +49,15 @@ TWISTED_BD = {
     "F": (0.0, -4.0e6, 0.0),
     "M": (3.54354215e7, 0.0, -6.87243219e6),
 }
-#: Wang et al. (2017), Table of the twisted beam as the r-test README quotes it: BeamDyn and
-#: ANSYS tip displacements, in the paper's axes (|x| is our |u_z|, |z| our |u_y|)
+#: Wang et al. (2017), the twisted beam's tip displacements by BeamDyn and ANSYS as the r-test
+#: README quotes them, in the paper's axes (|x| is our |u_z|, |z| our |u_y|)
 PAPER_BD = {"x": 1.132727, "z": 3.578671}
 PAPER_ANSYS = {"x": 1.134192, "z": 3.584232}
 
 
 def rotation_vector(c):
     """The rotation vector of Wiener–Milenkovic parameters ``c``: φ n, φ = 4 atan(|c|/4),
-    n = c/|c| (Bauchau 2011, 13.5; BeamDyn's TipRD outputs)."""
+    n = c/|c| (Bauchau, Flexible Multibody Dynamics, 2011; BeamDyn's TipRD outputs)."""
     c = np.asarray(c, float)
     size = np.linalg.norm(c)
     return c * (4 * math.atan(size / 4) / size) if size > 0 else c

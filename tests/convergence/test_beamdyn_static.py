@@ -105,3 +105,11 @@ def test_the_twisted_beams_root_reactions_balance_the_tip_load(tmp_path):
     assert np.allclose(root["force"], -F, rtol=0, atol=1e-9 * scale)
     arm = tip - np.asarray(root["position"])
     assert np.allclose(root["moment"], -np.cross(arm, F), rtol=0, atol=1e-9 * scale * 10.0)
+
+
+def test_wiener_milenkovic_parameters_become_the_rotation_vector():
+    """c = 4 tan(φ/4) n is the rotation φ about n (BeamDyn's TipRD), up to φ near 2π."""
+    n = np.array([2.0, -1.0, 0.5]) / np.linalg.norm([2.0, -1.0, 0.5])
+    for phi in (1e-8, 0.3, 1.5, 3.0, 6.0):
+        assert np.allclose(bd.rotation_vector(4 * np.tan(phi / 4) * n), phi * n, atol=1e-14)
+    assert not bd.rotation_vector(np.zeros(3)).any()
