@@ -14,6 +14,7 @@ def all_cases():
     """Import every paper module (they register their cases) and return the registry."""
     from . import (  # noqa: F401
         adaptive_bend45,
+        beamdyn_static,
         blade_prebend,
         classic,
         coupled_cantilever,

@@ -202,8 +202,10 @@ def profile_lines(results):
 
 
 def case_lines(r):
-    """Extra report lines of the adaptive and planar-vs-full cases (none for the others)."""
+    """Extra report lines of the adaptive and planar-vs-full cases and the BeamDyn cases
+    (none for the others)."""
     from .adaptive_bend45 import accuracy_lines
+    from .beamdyn_static import report_lines
     from .planar_rollup import planar_lines
 
-    return accuracy_lines(r) + planar_lines(r)
+    return accuracy_lines(r) + planar_lines(r) + report_lines(r)
