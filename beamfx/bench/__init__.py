@@ -29,6 +29,7 @@ def all_cases():
         schwab_meijaard_torque,
         shallow_arch,
         shallow_arch_bifurcation,
+        star_dome,
         transient,
     )
 
