@@ -72,7 +72,7 @@ def export(out_dir):
 
 
 def beamfx_trace(elements, degree, folder):
-    """beamfx's arc-length trace of one mesh through ``run_scene``: the limit point, the path
+    """The arc-length trace by beamfx of one mesh through ``run_scene``: the limit point, the path
     (load factor, apex uz) and the whole run's wall time."""
     from ..runner import run_scene
 
@@ -128,13 +128,15 @@ def report(beamfx_runs, opensees, meta):
     lines = [
         "# Star dome snap-through: beamfx beside OpenSeesPy",
         "",
-        "Made by `python -m beamfx.bench.star_dome_peers` (`make bench-peers`). The 24-member "
-        "star dome of demos/scenes/star_dome.toml (units cm, kN; pinned supports, shear-rigid "
-        "members, E = 3030, G = 1096, A = 3.17, I_y = I_z = 2.377, J = 2.1), apex load P: the "
-        "limit load of the symmetric path. beamfx: arc length through `run_scene`; OpenSeesPy "
-        f"{meta.get('openseespy', '?')}: {meta.get('element', '?')}, displacement control of "
-        f"the apex in steps of {STEP} cm, limit at the vertex of a parabola through the three "
-        "highest points. No published limit load could be checked offline for these values.",
+        (
+            "Made by `python -m beamfx.bench.star_dome_peers` (`make bench-peers`). The 24-member "
+            "star dome of demos/scenes/star_dome.toml (units cm, kN; pinned supports, shear-rigid "
+            "members, E = 3030, G = 1096, A = 3.17, I_y = I_z = 2.377, J = 2.1), apex load P: the "
+            "limit load of the symmetric path. beamfx: arc length through `run_scene`; OpenSeesPy "
+            f"{meta.get('openseespy', '?')}: {meta.get('element', '?')}, displacement control of "
+            f"the apex in steps of {STEP} cm, limit at the vertex of a parabola through the three "
+            "highest points. No published limit load could be checked offline for these values."
+        ),
         "",
     ]
     for p in sorted({r["degree"] for r in beamfx_runs}):
