@@ -62,6 +62,9 @@ bench-peers: install
 	$(PY) -m beamfx.bench.frame_peers export $(PEERS)
 	$(PEERS_PY) peers/opensees_frame.py $(PEERS)
 	$(PY) -m beamfx.bench.frame_peers $(PEERS) docs/validation
+	$(PY) -m beamfx.bench.star_dome_peers export $(PEERS)
+	$(PEERS_PY) peers/opensees_star_dome.py $(PEERS)
+	$(PY) -m beamfx.bench.star_dome_peers $(PEERS) docs/validation
 	$(PEERS_PY) peers/pybmodes_blade.py $(PEERS)
 
 lint: install

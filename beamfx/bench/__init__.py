@@ -19,6 +19,7 @@ def all_cases():
         classic,
         coupled_cantilever,
         howcroft_2016,
+        lattice_buckling,
         nrel5mw_blade,
         pai_beam,
         pai_rotating,
