@@ -14,12 +14,10 @@ from mpi4py import MPI
 
 from beamfx.solvers.convergence import FLOOR_LIMIT
 
-#: limit load (kN) of OpenSeesPy's corotational elasticBeamColumn elements, Richardson-
-#: extrapolated from 4, 8 and 16 elements per member (peers/opensees_star_dome.py, make
-#: bench-peers; docs/validation/star_dome.md)
-P_OPENSEES = None
-#: beamfx's converged limit load: P2 with 8 (extrapolated from 2, 4, 8: 75.6517) and P3 with 4
-#: elements per member (75.6519) agree to 5 digits (docs/validation/star_dome.md)
+#: beamfx's converged limit load (kN): P2 with 8 elements per member (extrapolated from 2, 4,
+#: 8: 75.6517) and P3 with 4 and 8 (75.6519, 75.6518) agree to 5 digits; OpenSeesPy's
+#: corotational elasticBeamColumn, extrapolated from 4, 8 and 16 elements per member: 75.649
+#: (docs/validation/star_dome.md)
 P_LIMIT = 75.652
 #: relative error of the limit load with one P3 element per member, measured 8.2e-3 against
 #: P_LIMIT; the tolerance keeps a factor ~1.2 for the limit point's placement by a quadratic
