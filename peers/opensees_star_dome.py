@@ -5,8 +5,8 @@ Each member is cut into n `elasticBeamColumn` elements (Euler-Bernoulli) with th
 `Corotational` transformation (OpenSees' geometrically nonlinear frame element), E = G = 1 and
 the section data as stiffnesses (A = EA, Jx = GJ, Iy = EI_y, Iz = EI_z). The apex is pushed
 down by displacement control (`DisplacementControl` on its uz, Newton), so the path is traced
-through the load maximum; the limit load is the vertex of the parabola through the largest
-load factor and its two neighbours. (`ElasticTimoshenkoBeam` is not used: with a
+through the load's extrema (the apex's displacement grows monotonically along this path: no
+snap-back in it); each extremum is the vertex of the parabola through it and its neighbours. (`ElasticTimoshenkoBeam` is not used: with a
 `Corotational` transformation it stays linear in OpenSees 3.x.)
 
 Runs in `.venv-peers` (openseespy, numpy; no beamfx).
@@ -74,31 +74,41 @@ def trace(problem, n):
     return np.array(path).T
 
 
-def limit_point(load, uz):
-    """(load, uz) at the vertex of the parabola through the largest load and its neighbours."""
-    i = int(np.argmax(load))
-    if i in (0, len(load) - 1):
-        raise RuntimeError("OpenSees: the path has no interior load maximum")
-    c = np.polyfit(uz[i - 1 : i + 2], load[i - 1 : i + 2], 2)
-    u = -c[1] / (2 * c[0])
-    return float(np.polyval(c, u)), float(u)
+def extrema(load, uz):
+    """[(kind, load, uz)] of every interior extremum of the load along the path, each at the
+    vertex of the parabola through it and its two neighbours."""
+    out = []
+    for i in range(1, len(load) - 1):
+        rise, fall = load[i] - load[i - 1], load[i + 1] - load[i]
+        if rise * fall < 0:
+            c = np.polyfit(uz[i - 1 : i + 2], load[i - 1 : i + 2], 2)
+            u = -c[1] / (2 * c[0])
+            out.append(("maximum" if rise > 0 else "minimum", float(np.polyval(c, u)), float(u)))
+    return out
 
 
 def run(out_dir):
-    """Trace every refinement of DIR/star_dome_problem.json; write DIR/opensees_star_dome.json."""
+    """Trace every refinement of every problem of DIR/star_dome_problem.json; write
+    DIR/opensees_star_dome.json."""
     out_dir = Path(out_dir)
-    problem = json.loads((out_dir / "star_dome_problem.json").read_text())
+    problems = json.loads((out_dir / "star_dome_problem.json").read_text())["problems"]
     records = []
-    for n in problem["elements"]:
-        t0 = time.perf_counter()
-        load, uz = trace(problem, n)
-        seconds = time.perf_counter() - t0
-        P, u = limit_point(load, uz)
-        records.append(
-            {"elements": n, "limit_load": P, "limit_uz": u, "wall_s": seconds,
-             "load": load.tolist(), "uz": uz.tolist()}
-        )  # fmt: skip
-        print(f"opensees star dome, {n} per member: limit {P:.6g} at uz {u:.5g} ({seconds:.1f} s)")
+    for problem in problems:
+        for n in problem["elements"]:
+            t0 = time.perf_counter()
+            load, uz = trace(problem, n)
+            seconds = time.perf_counter() - t0
+            found = extrema(load, uz)
+            first = next((e for e in found if e[0] == "maximum"), None)
+            if first is None:
+                raise RuntimeError(f"OpenSees: {problem['name']}: no load maximum")
+            records.append(
+                {"variant": problem["name"], "elements": n, "limit_load": first[1],
+                 "limit_uz": first[2], "extrema": found, "wall_s": seconds,
+                 "load": load.tolist(), "uz": uz.tolist()}
+            )  # fmt: skip
+            print(f"opensees {problem['name']}, {n} per member: first limit {first[1]:.6g} "
+                  f"at uz {first[2]:.5g} ({seconds:.1f} s)")  # fmt: skip
     meta = {"openseespy": version("openseespy"), "element": "elasticBeamColumn, Corotational"}
     (out_dir / "opensees_star_dome.json").write_text(json.dumps({"meta": meta, "records": records}))
 

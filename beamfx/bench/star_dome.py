@@ -7,7 +7,9 @@ joints, the six outer nodes pinned, shear-rigid members with E = 3030 kN/cm²,
 G = 1096 kN/cm², A = 3.17 cm², I_y = I_z = 2.377 cm⁴, J = 2.1 cm⁴, P = 1 kN times the load
 factor. The arc-length trace passes a bifurcation (a pair of negative eigenvalues: the
 asymmetric modes, double by the dome's symmetry) just before the symmetric limit point, and
-stays on the symmetric path, as displacement control does.
+stays on the symmetric path, as displacement control does. A second case,
+``star_dome_slender``, reads the literature's I = 2377 as mm⁴ (I = 0.2377 cm⁴): its apex snaps
+through locally (a maximum near 4.94 kN at 1.04 cm, a minimum near 3.48 kN at 2.4 cm).
 
 Reference: no published limit load could be checked offline for these section values, so the
 case's reference is withheld (the finest setting is the reference); the independent check is
@@ -28,12 +30,21 @@ SCENE = DEMOS / "star_dome.toml"
 APEX = "dome.1:start"
 
 
-def scene_data(elements=None, degree=None):
+#: the section's second moment of area as given (I = 2.377 cm⁴) and read as if the
+#: literature's 2377 were mm⁴ (I = 0.2377 cm⁴): the "slender" dome, whose apex snaps through
+#: locally first (two limit points and a minimum before 3 cm)
+BENDING_SCALE = {"star_dome": 1.0, "star_dome_slender": 0.1}
+
+
+def scene_data(elements=None, degree=None, variant="star_dome"):
     """The TOML data of demos/scenes/star_dome.toml, with ``elements`` per member of degree
-    ``degree`` if given."""
+    ``degree`` if given; ``variant`` "star_dome_slender": EI_y and EI_z ten times smaller."""
     data = tomllib.loads(SCENE.read_text())
     if elements is not None:
         data["frames"][0].update(elements=elements, degree=degree)
+    for member in data["frames"][0]["members"]:
+        for key in ("EI_y", "EI_z"):
+            member["section"][key] *= BENDING_SCALE[variant]
     return data
 
 
@@ -57,6 +68,12 @@ def _snap(elements, degree):
     return [(scene(elements, degree), read_limit)]
 
 
+def _slender_snap(elements, degree):
+    data = scene_data(elements, degree, "star_dome_slender")
+    data["analysis"].update(displacement_limit=["uz", -1.5], arc_length=0.1)
+    return [(scene(data=data), read_limit)]
+
+
 register(
     SceneCase(
         "star_dome",
@@ -73,5 +90,22 @@ register(
         "is the reference. The independent check, OpenSeesPy with corotational "
         "elasticBeamColumn elements under displacement control, is in "
         "docs/validation/star_dome.md (make bench-peers).",
+    )
+)
+
+register(
+    SceneCase(
+        "star_dome_slender",
+        "Meek & Tan 1984 (star dome)",
+        "24-member star dome, I = 0.2377 cm⁴, apex load: the apex's local snap-through load",
+        _slender_snap,
+        lambda values: values,
+        None,
+        1e-4,
+        tuple((n, p) for p in (2, 3) for n in (1, 2, 4, 8)),
+        note="The demo scene with EI ten times smaller (the literature's I = 2377 read as mm⁴): "
+        "the first limit point (about 1 cm down), traced by arc length to 1.5 cm. Reference "
+        "withheld: the finest setting is the reference; OpenSeesPy beside it in "
+        "docs/validation/star_dome.md.",
     )
 )
