@@ -79,3 +79,26 @@ def test_star_dome_limit_load_converges(tmp_path):
     assert d1 < 0 and d2 < 0 and abs(d2) < abs(d1) / 4  # at least second order
     extrapolated = P[2] - d2**2 / (d2 - d1)
     assert abs(extrapolated - P_LIMIT) < abs(d2)
+
+
+def test_star_dome_geometry_copy_and_members():
+    """The scene's .geo is the copy of meshes/star_dome/star_dome.geo; 13 nodes, 24 members of
+    the lengths the geometry gives (ribs 25.08, ring 25, legs 31.60)."""
+    from pathlib import Path
+
+    from beamfx.geometry.line_mesh import read_line_mesh
+
+    root = Path(__file__).resolve().parents[2]
+    master = root / "meshes" / "star_dome" / "star_dome.geo"
+    assert (root / "demos" / "scenes" / "star_dome.geo").read_bytes() == master.read_bytes()
+    mesh = read_line_mesh(master)
+    assert len(mesh.points) == 13 and len(mesh.members) == 24
+    lengths = np.linalg.norm(np.diff(mesh.points[mesh.members], axis=1)[:, 0], axis=1)
+    expected = {
+        "ribs": np.hypot(25, 2),
+        "ring": 25.0,
+        "legs": np.sqrt(25**2 + 50**2 - 2 * 25 * 50 * np.cos(np.pi / 6) + 6.216**2),
+    }
+    for group, length in expected.items():
+        assert np.allclose(lengths[mesh.member_groups[group]], length, rtol=1e-12)
+    assert sorted(len(v) for v in mesh.member_groups.values()) == [6, 6, 12]
