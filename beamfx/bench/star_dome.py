@@ -64,6 +64,12 @@ def read_limit(result):
     return {"limit_load": top["load_factor"], "limit_uz": top["displacement"][2]}
 
 
+def _limit_load(values):
+    """The metric: the limit load alone (the apex's displacement at a flat maximum is placed
+    far less precisely than the load)."""
+    return {"limit_load": values["limit_load"]}
+
+
 def _snap(elements, degree):
     return [(scene(elements, degree), read_limit)]
 
@@ -80,7 +86,7 @@ register(
         "Meek & Tan 1984 (star dome)",
         "24-member star dome, apex load: symmetric snap-through (limit) load",
         _snap,
-        lambda values: values,
+        _limit_load,
         None,
         1e-4,
         tuple((n, p) for p in (2, 3) for n in (1, 2, 4, 8)),
@@ -99,7 +105,7 @@ register(
         "Meek & Tan 1984 (star dome)",
         "24-member star dome, I = 0.2377 cm⁴, apex load: the apex's local snap-through load",
         _slender_snap,
-        lambda values: values,
+        _limit_load,
         None,
         1e-4,
         tuple((n, p) for p in (2, 3) for n in (1, 2, 4, 8)),
