@@ -135,13 +135,10 @@ class ReactionRecovery:
     gradient of ``Pi_ground`` if the model has springs or local-axes supports)."""
 
     def __init__(self, model):
-        import dolfinx.fem.petsc as fp
-
         from ..solvers.forms import compile_form
 
         self.model, self.layout = model, _layout(model)
-        self.F = compile_form(model.F)
-        self.b = fp.create_vector(self.F)
+        self._F = self.b = None  # compiled at first use (a transient uses its own residual)
         self.ground = None
         if model.Pi_ground is not None:
             test = ufl.TestFunction(model.W)
@@ -160,11 +157,23 @@ class ReactionRecovery:
             ground = at_point if at in spring_points else np.zeros(n, bool)
             self.points[at] = (at_point & held, ground)
 
-    def _assemble(self, form, load_factor=None):
-        """``form`` assembled with no Dirichlet rows, ghosts updated; a copy of the array."""
+    @property
+    def F(self):
+        """The model's residual, compiled at first use."""
+        if self._F is None:
+            from ..solvers.forms import compile_form
+
+            self._F = compile_form(self.model.F)
+        return self._F
+
+    def assemble(self, form, load_factor=None):
+        """``form`` (a linear form on ``W``) assembled with no Dirichlet rows, ghosts
+        updated; a copy of the array."""
         import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
 
+        if self.b is None:
+            self.b = fp.create_vector(form)
         if load_factor is not None:
             self.model.load_factor.value = load_factor
         with self.b.localForm() as local:
@@ -179,7 +188,7 @@ class ReactionRecovery:
         """The nodal load vector λ f_ext at the current state, F(λ=0) − F(λ=1) times λ."""
         lam = float(self.model.load_factor.value)
         try:
-            f = self._assemble(self.F, 0.0) - self._assemble(self.F, 1.0)
+            f = self.assemble(self.F, 0.0) - self.assemble(self.F, 1.0)
         finally:
             self.model.load_factor.value = lam
         return lam * f
@@ -187,17 +196,7 @@ class ReactionRecovery:
     def __call__(self):
         """``({point: Reaction}, Balance)`` at the current state. Collective."""
         model, layout = self.model, self.layout
-        residual = self._assemble(self.F)
-        spring = -self._assemble(self.ground) if self.ground is not None else None
-        out, total = {}, np.zeros(6)
-        for at, (held, ground) in self.points.items():
-            force, moment, _, _ = resultant(model, layout, residual, held)
-            if spring is not None and ground.any():
-                f2, m2, _, _ = resultant(model, layout, spring, ground)
-                force, moment = force + f2, moment + m2
-            total += np.r_[force, moment]
-            x = _point_position(model, layout, self.dofs[at])
-            out[at] = Reaction(force.tolist(), (moment - np.cross(x, force)).tolist(), x.tolist())
+        out, total = self.at_points(self.assemble(self.F))
         load = self.applied()
         force, moment, f_scale, m_scale = resultant(model, layout, load, np.ones(len(load), bool))
         balance = Balance(
@@ -207,6 +206,23 @@ class ReactionRecovery:
             moment.tolist(),
         )
         return out, balance
+
+    def at_points(self, residual):
+        """``({point: Reaction}, Σ (force, moment about the origin))`` of ``residual`` (an
+        array on ``W``, owned entries at least; its held rows are the reactions) and of the
+        springs at the current state. Collective."""
+        model, layout = self.model, self.layout
+        spring = -self.assemble(self.ground) if self.ground is not None else None
+        out, total = {}, np.zeros(6)
+        for at, (held, ground) in self.points.items():
+            force, moment, _, _ = resultant(model, layout, residual, held)
+            if spring is not None and ground.any():
+                f2, m2, _, _ = resultant(model, layout, spring, ground)
+                force, moment = force + f2, moment + m2
+            total += np.r_[force, moment]
+            x = _point_position(model, layout, self.dofs[at])
+            out[at] = Reaction(force.tolist(), (moment - np.cross(x, force)).tolist(), x.tolist())
+        return out, total
 
 
 def _point_position(model, layout, dofs):
@@ -265,6 +281,10 @@ def entries(model):
 def balance_line(entry):
     """One log line of :func:`entries`: the reaction points and the balance residuals."""
     n, balance = len(entry["reactions"]), entry["reaction_balance"]
+    if balance is not None and "inertia_force" in balance:
+        from .transient_reactions import balance_line as transient_line
+
+        return transient_line(entry)
     if balance is None:
         return (
             f"reactions: {n} support(s), from the section resultants at the clamp "
