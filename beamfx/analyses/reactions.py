@@ -281,10 +281,14 @@ def entries(model):
 def balance_line(entry):
     """One log line of :func:`entries`: the reaction points and the balance residuals."""
     n, balance = len(entry["reactions"]), entry["reaction_balance"]
-    if balance is not None and "inertia_force" in balance:
-        from .transient_reactions import balance_line as transient_line
-
-        return transient_line(entry)
+    if balance is not None and "inertia_force" in balance:  # a transient's (its last row)
+        inertia = np.round(balance["inertia_force"], 9).tolist()
+        return (
+            f"reactions: {n} point(s) at the output steps; balance with the applied loads and "
+            f"the inertia forces (last, t = {balance['time']:.6g}: inertia force {inertia}): "
+            f"max |ΣF|/scale = {balance['max_force']:.1e}, "
+            f"max |ΣM|/scale = {balance['max_moment']:.1e}"
+        )
     if balance is None:
         return (
             f"reactions: {n} support(s), from the section resultants at the clamp "

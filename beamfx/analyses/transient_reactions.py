@@ -238,15 +238,3 @@ class ReactionSeries:
         """The ``reaction_history`` entry of ``results.json``: the file, its rows, and the
         largest |force| and |moment| of each point over the run, with their times."""
         return {"csv": self.path.name, "rows": self.peaks.rows, "peaks": self.peaks.points}
-
-
-def balance_line(entry):
-    """The log line of a transient's :meth:`ReactionSeries.entries`."""
-    b = entry["reaction_balance"]
-    inertia = np.round(b["inertia_force"], 9).tolist()
-    return (
-        f"reactions: {len(entry['reactions'])} point(s) at the output steps; balance with the "
-        f"applied loads and the inertia forces (last, t = {b['time']:.6g}: inertia force "
-        f"{inertia}): max |ΣF|/scale = {b['max_force']:.1e}, max |ΣM|/scale = "
-        f"{b['max_moment']:.1e}"
-    )

@@ -149,3 +149,30 @@ def test_spin_up_hub_torque_balances_the_inertia_and_does_the_work(tmp_path):
     assert work > 0
     assert work == pytest.approx(run["energy"]["work_supports"], rel=3e-3)
     assert np.allclose(vec(data, "inertia_m_")[:, 2], data["beam:start_mz"], rtol=1e-8)
+
+
+def test_restart_cuts_and_continues_the_series(tmp_path):
+    """A run stopped at t = 0.25 s and restarted to 0.5 s writes the rows and peaks of one
+    run to 0.5 s (rows past the checkpoint are cut away first)."""
+    quiet = {"log": lambda m: None}
+    short = SPIN.replace("t_end = 1.5", "t_end = 0.25").replace(
+        "\noutput_every", "\ncheckpoint_every = 4\noutput_every"
+    )
+    (tmp_path / "a.toml").write_text(short.replace("t_end = 0.25", "t_end = 0.5"))
+    (tmp_path / "b.toml").write_text(short)
+    whole = run_scene(tmp_path / "a.toml", tmp_path / "whole", **quiet)
+    run_scene(tmp_path / "b.toml", tmp_path / "parts", **quiet)
+    with (tmp_path / "parts" / "reactions.csv").open("a") as f:
+        f.write("99,0.3,1,2,3\n")  # a row cut short by a killed run: dropped
+    parts = run_scene(tmp_path / "a.toml", tmp_path / "parts", restart=True, **quiet)
+    a, _ = rows_of(tmp_path / "whole")
+    b, _ = rows_of(tmp_path / "parts")
+    assert np.array_equal(a["step"], b["step"]) and len(a["step"]) == 20
+    assert np.allclose(b["beam:start_mz"], a["beam:start_mz"], rtol=1e-9, atol=1e-12)
+    peaks = [r["reaction_history"]["peaks"]["beam:start"] for r in (parts, whole)]
+    assert peaks[0] == pytest.approx(peaks[1], rel=1e-9)
+    assert parts["reaction_history"]["rows"] == 20
+    # the largest balance residual (relative) is at the first steps: read back from the file
+    first = a["balance_force"][:10].max()
+    assert first > a["balance_force"][10:].max()
+    assert parts["reaction_balance"]["max_force"] == pytest.approx(first, rel=1e-9)
