@@ -36,7 +36,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .dofs import constrained_dofs, owned_size
-from .reactions import ReactionRecovery, resultant
+from .reactions import ReactionRecovery
 
 AXES = ("x", "y", "z")
 
@@ -85,16 +85,20 @@ class TransientReactions:
         else:
             R = np.zeros(n)
             R[: len(residual)] = residual
-        reactions, total = rec.at_points(R)
+        inertia = rec.assemble(self.inertia)
+        if self.loads is None:
+            reactions, total, [inert] = rec.at_points(R, [inertia])
+            applied = np.zeros(8)
+        else:
+            reactions, total, [inert, applied] = rec.at_points(
+                R, [inertia, rec.assemble(self.loads)]
+            )
         free = R[: len(self.free)][self.free]
         free_residual = float(np.sqrt(model.comm.allreduce(float(free @ free))))
-        every = np.ones(n, bool)
-        load = rec.assemble(self.loads) if self.loads is not None else np.zeros(n)
-        fa, ma, sfa, sma = resultant(model, rec.layout, load, every)
-        fi, mi, sfi, smi = resultant(model, rec.layout, rec.assemble(self.inertia), every)
+        fa, ma, fi, mi = applied[:3], applied[3:6], inert[:3], inert[3:6]
         balance = DynamicBalance(
-            float(np.linalg.norm(total[:3] + fa - fi) / max(sfa + sfi, 1e-300)),
-            float(np.linalg.norm(total[3:] + ma - mi) / max(sma + smi, 1e-300)),
+            float(np.linalg.norm(total[:3] + fa - fi) / max(applied[6] + inert[6], 1e-300)),
+            float(np.linalg.norm(total[3:] + ma - mi) / max(applied[7] + inert[7], 1e-300)),
             fa.tolist(),
             ma.tolist(),
             fi.tolist(),
