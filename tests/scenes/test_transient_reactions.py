@@ -190,3 +190,26 @@ def test_restart_cuts_and_continues_the_series(tmp_path):
     first = a["balance_force"][:10].max()
     assert first > a["balance_force"][10:].max()
     assert parts["reaction_balance"]["max_force"] == pytest.approx(first, rel=1e-9)
+
+
+def test_free_flight_inertia_force_is_the_rate_of_the_momentum(tmp_path):
+    """The flying spaghetti (no support; tests/scenes/test_free_body.py), its first second
+    with trapezoidal steps: Σ loads = Σ inertia forces at every step, and the inertia force
+    is the rate of the linear momentum that the energy balance integrates independently
+    (∫ ρA u̇ ds): the trapezoidal rule with a constant translational mass gives
+    P_{n+1} − P_n = h (I_n + I_{n+1}) / 2 exactly, so to round-off."""
+    from test_free_body import SPAGHETTI
+
+    scene = SPAGHETTI.replace("t_end = 5.5", "t_end = 1.0\noutput_every = 1")
+    (tmp_path / "f.toml").write_text(scene)
+    run = run_scene(tmp_path / "f.toml", tmp_path / "out", log=lambda m: None)
+    data, points = rows_of(tmp_path / "out")
+    assert points == [] and len(data["step"]) == 20
+    check_balance(data, points, run["model"]["unknowns"], 10.0)
+    lines = (tmp_path / "out" / "probes.jsonl").read_text().splitlines()
+    momentum = np.array([json.loads(x)["energy"]["linear_momentum"] for x in lines])
+    inertia = np.vstack([np.zeros(3), vec(data, "inertia_f_")])  # at rest at t = 0
+    steps = np.diff(np.r_[0.0, data["time"]])[:, None]
+    predicted = steps * 0.5 * (inertia[1:] + inertia[:-1])
+    assert np.abs(predicted).max() > 0.1  # the force moved the body
+    assert np.allclose(np.diff(momentum, axis=0), predicted, rtol=0, atol=1e-12 * 8)
