@@ -94,7 +94,10 @@ class TransientReactions:
                 R, [inertia, rec.assemble(self.loads)]
             )
         free = R[: len(self.free)][self.free]
-        free_residual = float(np.sqrt(model.comm.allreduce(float(free @ free))))
+        squares = float(free @ free)
+        free_residual = float(
+            np.sqrt(model.comm.allreduce(squares) if model.comm.size > 1 else squares)
+        )
         fa, ma, fi, mi = applied[:3], applied[3:6], inert[:3], inert[3:6]
         balance = DynamicBalance(
             float(np.linalg.norm(total[:3] + fa - fi) / max(applied[6] + inert[6], 1e-300)),
