@@ -22,6 +22,9 @@ distributed loads and gravity enter as the forms state them.
 Supports in local axes and springs to ground are penalty springs in the energy
 (``Pi_ground``): their reaction is the spring force, minus its energy gradient.
 
+A transient reuses the per-point recovery on its step's residual, which holds the inertia
+forces too (:mod:`beamfx.analyses.transient_reactions`).
+
 Everything is MPI-correct by construction: vectors are assembled with the reverse scatter, each
 rank sums its owned dofs, and the sums are reduced.
 """

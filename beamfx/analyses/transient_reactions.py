@@ -3,8 +3,8 @@ the inertia forces.
 
 **What balances.** The step's residual is F(q_{n+1}) = F_int − f(t_{n+1}) + I, with I the
 inertia (and Rayleigh damping) forces, the Lagrange derivative of the kinetic energy
-evaluated at the integrator's own rates q̇_{n+1}, q̈_{n+1} (:class:`~beamfx.analyses.transient.
-Dynamics`). Newton zeroes it at the free dofs; at the held dofs it is the force that holds them,
+evaluated at the integrator's own rates q̇_{n+1}, q̈_{n+1}
+(:class:`~beamfx.analyses.transient.Dynamics`). Newton zeroes it at the free dofs; at the held dofs it is the force that holds them,
 the reaction r, as in statics (:mod:`beamfx.analyses.reactions`, whose per-point recovery is
 reused). Summing every row by the discrete rigid motions (translations, and rotations about the
 origin), under which the strain energy is invariant, gives
@@ -15,7 +15,7 @@ to Newton's tolerance and round-off. By Noether's theorem (the kinetic energy is
 the same rigid motions, lifted to the rates) Σ I is the rate of the linear momentum and of the
 angular momentum about the origin, d/dt (P, L) at (q_{n+1}, q̇_{n+1}, q̈_{n+1}), plus the
 resultant of the mass-proportional damping force a0 M q̇ (the stiffness-proportional damping
-is internal: it resultant is zero).
+is internal: its resultant is zero).
 
 **At which time it holds.** The integrators are written in the form of Arnold & Brüls (2007)
 (:mod:`beamfx.solvers.integrators`): the equations of motion hold exactly at t_{n+1} with the

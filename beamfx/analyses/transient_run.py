@@ -2,7 +2,8 @@
 
 Every step appends a row to ``probes.csv`` and a line to ``probes.jsonl`` (time, step size,
 Newton iterations, the probes' position, displacement and unwrapped rotation, and the
-energy balance); frames every ``output_every`` steps (or as ``[output]`` says); every
+energy balance); frames every ``output_every`` steps (or as ``[output]`` says), and at each
+frame a row of ``reactions.csv`` (:mod:`~beamfx.analyses.transient_reactions`); every
 ``checkpoint_every`` steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
