@@ -22,6 +22,9 @@ distributed loads and gravity enter as the forms state them.
 Supports in local axes and springs to ground are penalty springs in the energy
 (``Pi_ground``): their reaction is the spring force, minus its energy gradient.
 
+A transient reuses the per-point recovery on its step's residual, which holds the inertia
+forces too (:mod:`beamfx.analyses.transient_reactions`).
+
 Everything is MPI-correct by construction: vectors are assembled with the reverse scatter, each
 rank sums its owned dofs, and the sums are reduced.
 """
@@ -80,6 +83,12 @@ def _layout(model):
     return _Layout(rows[0][0], axes, rows[0][1], rows[1][0])
 
 
+def _cross(a, b):
+    """The cross product row by row of (n, 3) arrays (np.cross costs tens of µs a call)."""
+    a0, a1, a2, b0, b1, b2 = a[:, 0], a[:, 1], a[:, 2], b[:, 0], b[:, 1], b[:, 2]
+    return np.column_stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
+
+
 def _nodal_moments(model, layout, r):
     """Moment (global axes) of the rotation residual rows ``r`` at each owned rotation node."""
     kin = model.kin
@@ -90,28 +99,39 @@ def _nodal_moments(model, layout, r):
         return r
     q = model.w.x.array[layout.q]
     q0, v, r0, rv = q[:, :1], q[:, 1:], r[:, :1], r[:, 1:]
-    return 0.5 * (q0 * rv - r0 * v + np.cross(v, rv))
+    return 0.5 * (q0 * rv - r0 * v + _cross(v, rv))
+
+
+def positions(model, layout):
+    """Positions of the owned displacement nodes: current for finite kinematics."""
+    x = np.array(layout.X)
+    if model.kin.finite:
+        x[:, layout.axes] += model.w.x.array[layout.u]
+    return x
+
+
+def local_resultant(model, layout, values, mask=None, x=None):
+    """This rank's part of :func:`resultant` (8 numbers), all dofs if ``mask`` is None, ``x``
+    the nodes' :func:`positions` if known."""
+    picked = values if mask is None else np.where(mask, values, 0.0)
+    f = np.zeros((len(layout.u), 3))
+    f[:, layout.axes] = picked[layout.u]
+    x = positions(model, layout) if x is None else x
+    m = _nodal_moments(model, layout, picked[layout.q])
+    size = np.sqrt((f * f).sum(1))
+    local = np.empty(8)
+    local[:3] = f.sum(0)
+    local[3:6] = _cross(x, f).sum(0) + m.sum(0)
+    local[6] = size.sum()
+    local[7] = (np.sqrt((x * x).sum(1)) * size).sum() + np.sqrt((m * m).sum(1)).sum()
+    return local
 
 
 def resultant(model, layout, values, mask):
     """Σ force and Σ moment about the origin of the nodal ``values`` (an array on ``W``,
     ghosts included) at the dofs where ``mask`` is true, with the scales of :class:`Balance`:
     (force, moment, force scale, moment scale), summed over ranks. Collective."""
-    picked = np.where(mask, values, 0.0)
-    f = np.zeros((len(layout.u), 3))
-    f[:, layout.axes] = picked[layout.u]
-    x = np.array(layout.X)
-    if model.kin.finite:
-        x[:, layout.axes] += model.w.x.array[layout.u]
-    m = _nodal_moments(model, layout, picked[layout.q])
-    local = np.r_[
-        f.sum(0),
-        np.cross(x, f).sum(0) + m.sum(0),
-        np.linalg.norm(f, axis=1).sum(),
-        (np.linalg.norm(x, axis=1) * np.linalg.norm(f, axis=1)).sum()
-        + np.linalg.norm(m, axis=1).sum(),
-    ]
-    total = model.comm.allreduce(local, op=MPI.SUM)
+    total = model.comm.allreduce(local_resultant(model, layout, values, mask), op=MPI.SUM)
     return total[:3], total[3:6], total[6], total[7]
 
 
@@ -135,13 +155,10 @@ class ReactionRecovery:
     gradient of ``Pi_ground`` if the model has springs or local-axes supports)."""
 
     def __init__(self, model):
-        import dolfinx.fem.petsc as fp
-
         from ..solvers.forms import compile_form
 
         self.model, self.layout = model, _layout(model)
-        self.F = compile_form(model.F)
-        self.b = fp.create_vector(self.F)
+        self._F = self.b = None  # compiled at first use (a transient uses its own residual)
         self.ground = None
         if model.Pi_ground is not None:
             test = ufl.TestFunction(model.W)
@@ -151,20 +168,34 @@ class ReactionRecovery:
         held[constrained_dofs(model.bcs)] = True
         self.points = {}  # at -> (Dirichlet mask, spring mask)
         self.dofs = {}  # at -> its dofs (located once: 2 ms a call on 16 cells)
+        self.rows = {}  # at -> its row of layout.u on the rank that owns it (else none)
         spring_points = [s.at for s in model.spec.springs]
         spring_points += [s.at for s in model.spec.supports if s.axes == "local"]
         for at in dict.fromkeys([s.at for s in model.spec.supports] + spring_points):
             at_point = np.zeros(n, bool)
             self.dofs[at] = _vertex_dofs(model, at)
+            self.rows[at] = np.flatnonzero(np.isin(self.layout.u[:, 0], self.dofs[at]))[:1]
             at_point[self.dofs[at]] = True
             ground = at_point if at in spring_points else np.zeros(n, bool)
             self.points[at] = (at_point & held, ground)
 
-    def _assemble(self, form, load_factor=None):
-        """``form`` assembled with no Dirichlet rows, ghosts updated; a copy of the array."""
+    @property
+    def F(self):
+        """The model's residual, compiled at first use."""
+        if self._F is None:
+            from ..solvers.forms import compile_form
+
+            self._F = compile_form(self.model.F)
+        return self._F
+
+    def assemble(self, form, load_factor=None):
+        """``form`` (a linear form on ``W``) assembled with no Dirichlet rows, ghosts
+        updated; a copy of the array."""
         import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
 
+        if self.b is None:
+            self.b = fp.create_vector(form)
         if load_factor is not None:
             self.model.load_factor.value = load_factor
         with self.b.localForm() as local:
@@ -179,27 +210,16 @@ class ReactionRecovery:
         """The nodal load vector λ f_ext at the current state, F(λ=0) − F(λ=1) times λ."""
         lam = float(self.model.load_factor.value)
         try:
-            f = self._assemble(self.F, 0.0) - self._assemble(self.F, 1.0)
+            f = self.assemble(self.F, 0.0) - self.assemble(self.F, 1.0)
         finally:
             self.model.load_factor.value = lam
         return lam * f
 
     def __call__(self):
         """``({point: Reaction}, Balance)`` at the current state. Collective."""
-        model, layout = self.model, self.layout
-        residual = self._assemble(self.F)
-        spring = -self._assemble(self.ground) if self.ground is not None else None
-        out, total = {}, np.zeros(6)
-        for at, (held, ground) in self.points.items():
-            force, moment, _, _ = resultant(model, layout, residual, held)
-            if spring is not None and ground.any():
-                f2, m2, _, _ = resultant(model, layout, spring, ground)
-                force, moment = force + f2, moment + m2
-            total += np.r_[force, moment]
-            x = _point_position(model, layout, self.dofs[at])
-            out[at] = Reaction(force.tolist(), (moment - np.cross(x, force)).tolist(), x.tolist())
         load = self.applied()
-        force, moment, f_scale, m_scale = resultant(model, layout, load, np.ones(len(load), bool))
+        out, total, [applied] = self.at_points(self.assemble(self.F), [load])
+        force, moment, f_scale, m_scale = applied[:3], applied[3:6], applied[6], applied[7]
         balance = Balance(
             float(np.linalg.norm(total[:3] + force) / max(f_scale, 1e-300)),
             float(np.linalg.norm(total[3:] + moment) / max(m_scale, 1e-300)),
@@ -208,17 +228,39 @@ class ReactionRecovery:
         )
         return out, balance
 
-
-def _point_position(model, layout, dofs):
-    """Position of the named point whose dofs are ``dofs`` (:func:`_vertex_dofs`; current for
-    finite kinematics). Collective."""
-    rows = np.flatnonzero(np.isin(layout.u[:, 0], dofs))[:1]
-    x = np.array(layout.X[rows])
-    if model.kin.finite:
-        x[:, layout.axes] += model.w.x.array[layout.u[rows]]
-    local = np.r_[x.sum(0), len(rows)]
-    total = model.comm.allreduce(local, op=MPI.SUM)
-    return total[:3] / max(total[3], 1)
+    def at_points(self, residual, extra=()):
+        """``({point: Reaction}, Σ (force, moment about the origin), [resultant of each of
+        extra])`` of ``residual`` (an array on ``W``, owned entries at least; its held rows
+        are the reactions) and of the springs at the current state; ``extra``: arrays whose
+        :func:`resultant` over all dofs (8 numbers) is reduced in the same call. Collective:
+        one reduction."""
+        model, layout = self.model, self.layout
+        spring = -self.assemble(self.ground) if self.ground is not None else None
+        x = positions(model, layout)
+        parts = []
+        for at, (held, ground) in self.points.items():
+            parts.append(local_resultant(model, layout, residual, held, x))
+            if spring is not None and ground.any():
+                parts.append(local_resultant(model, layout, spring, ground, x))
+            else:  # (every rank adds its part: the reduction is collective)
+                parts.append(np.zeros(8))
+            rows = self.rows[at]
+            parts.append(np.append(x[rows].sum(0), len(rows)))
+        parts += [local_resultant(model, layout, v, None, x) for v in extra]
+        total = np.concatenate(parts or [np.zeros(0)])
+        if model.comm.size > 1:  # (on one rank the reduction is the identity: 50 µs saved)
+            total = model.comm.allreduce(total, op=MPI.SUM)
+        out, sums = {}, np.zeros(6)
+        for i, at in enumerate(self.points):
+            held, ground = total[20 * i : 20 * i + 8], total[20 * i + 8 : 20 * i + 16]
+            p = total[20 * i + 16 : 20 * i + 20]  # Σ position, count (one rank has it)
+            force, moment = held[:3] + ground[:3], held[3:6] + ground[3:6]
+            sums += np.r_[force, moment]
+            xp = p[:3] / max(p[3], 1)
+            about = moment - _cross(xp[None], force[None])[0]
+            out[at] = Reaction(force.tolist(), about.tolist(), xp.tolist())
+        k = 20 * len(self.points)
+        return out, sums, [total[k + 8 * j : k + 8 * j + 8] for j in range(len(extra))]
 
 
 def condensed_reactions(model, evaluate):
@@ -265,6 +307,14 @@ def entries(model):
 def balance_line(entry):
     """One log line of :func:`entries`: the reaction points and the balance residuals."""
     n, balance = len(entry["reactions"]), entry["reaction_balance"]
+    if balance is not None and "inertia_force" in balance:  # a transient's (its last row)
+        inertia = np.round(balance["inertia_force"], 9).tolist()
+        return (
+            f"reactions: {n} point(s) at the output steps; balance with the applied loads and "
+            f"the inertia forces (last, t = {balance['time']:.6g}: inertia force {inertia}): "
+            f"max |ΣF|/scale = {balance['max_force']:.1e}, "
+            f"max |ΣM|/scale = {balance['max_moment']:.1e}"
+        )
     if balance is None:
         return (
             f"reactions: {n} support(s), from the section resultants at the clamp "

@@ -162,7 +162,10 @@ class Dynamics:
             inertia += ufl.derivative(D, V, test)
             power += 2 * D
         v_expr, qdd_expr = self.scheme.rates(w, self.q_n, self.v_n, self.a_n, self.qdd_n)
-        self.F = model.F + ufl.replace(inertia, {V: v_expr, A: qdd_expr})
+        # the inertia (and damping) forces of the step: their resultant is the rate of the
+        # momenta at t_{n+1} (transient_reactions.py)
+        self.inertia_forces = ufl.replace(inertia, {V: v_expr, A: qdd_expr})
+        self.F = model.F + self.inertia_forces
         self.J = ufl.derivative(self.F, w, ufl.TrialFunction(W))
         # energies at the state (w, v_n): evaluated after v_n holds the new velocity
         self.kinetic = ufl.replace(T, {V: self.v_n})
@@ -468,6 +471,7 @@ class _March(NamedTuple):
     dt_min: float
     length: float  # the scale of the displacements, for the error estimate
     log: object
+    reactions: object = None  # called at each converged step (transient_reactions.py)
 
 
 def _step(m, control, t, failed):
@@ -517,21 +521,25 @@ def _newton(m, t, h):
     return m.solver.solve()
 
 
-def _accept(m, t, h, q_old):
-    """Move the state on from ``t`` to t + h after a converged step (``q_old`` gets q_n);
-    returns the energy balance at t + h."""
+def _accept(m, t, h, q_old, step):
+    """Move the state on from ``t`` to t + h (step ``step``) after a converged step (``q_old``
+    gets q_n); returns the energy balance at t + h. The support reactions are taken before
+    the state moves on: the residual's rates are expressions of the state at t_n."""
     q_old[:] = m.dyn.q_n.x.array
     if m.dyn.extrapolation:
         m.dyn.extrapolation.accept()
     else:
-        m.balance.reactions(m.solver.residual_at_solution())
+        residual = m.solver.residual_at_solution()
+        m.balance.reactions(residual)
+        if m.reactions is not None:
+            m.reactions(step, t + h, t + h >= m.settings.t_end * (1 - 1e-12), residual)
         m.dyn.accept(h)
     if m.projection:
         m.projection.apply(t, t + h)
     return m.balance.record(q_old, h)
 
 
-def _march(model, s, options, prefix, log):
+def _march(model, s, options, prefix, log, reactions=None):
     """The :class:`_March` of ``model`` with ``settings`` ``s``, and the forms' compile time."""
     from ..solvers.forms import compile_seconds
 
@@ -540,14 +548,19 @@ def _march(model, s, options, prefix, log):
     solver = NewtonSolver(dyn.F, dyn.J, model.w, model.bcs, prefix, options)
     solver.set_atol(max(1e-14 * float(model.k_penalty.value), 1e-14))
     balance = EnergyBalance(dyn, solver.F)
-    if balance.moving:  # the reactions of each step from Newton's last residual
+    if balance.moving or reactions:  # the reactions of each step from Newton's last residual
         solver.keep_residual()
+    if reactions and s.scheme != "extrapolated":  # (a combination has no residual of its own)
+        reactions.start(dyn, solver.F)
+    else:
+        reactions = None
     projection = Projection(dyn, balance) if s.scheme == "conserving" else None
     if s.scheme == "extrapolated":
         dyn.extrapolation = Extrapolation(dyn, solver, balance)
     dt_min = s.dt_min or s.dt / 1000
     length = model_size(model.spec)
-    m = _March(model, s, dyn, solver, balance, projection, dt_min, length, log or (lambda _: None))
+    quiet = log or (lambda _: None)
+    m = _March(model, s, dyn, solver, balance, projection, dt_min, length, quiet, reactions)
     return m, compile_seconds[0] - c0
 
 
@@ -561,6 +574,7 @@ def solve_transient(
     checkpoint=None,
     saved=None,
     prefix="beamfx_transient_",
+    reactions=None,
 ):
     """March from t = 0 (at rest in the model's current state) to ``settings.t_end``.
 
@@ -573,7 +587,9 @@ def solve_transient(
     ``checkpoint_every`` steps, at the end, before a failure is raised and when the march is
     interrupted (:mod:`beamfx.interrupt`: a SIGINT or SIGTERM stops it at an accepted step,
     ``stopped_by`` then names the signal), with :func:`checkpoint_state`; pass such a state as
-    ``saved`` to go on from it.
+    ``saved`` to go on from it. ``reactions``: its ``start(dyn, residual)`` once, then
+    ``reactions(step, t, last, residual)`` at every converged step before the state moves on
+    (:class:`~beamfx.analyses.transient_reactions.ReactionSeries`; not with "extrapolated").
 
     Raises:
         TransientFailed: naming the time, the step size and the residual history, after the
@@ -582,7 +598,7 @@ def solve_transient(
     from ..interrupt import pending, reason
 
     t_start, s = time.perf_counter(), settings
-    m, compile_time = _march(model, s, options, prefix, log)
+    m, compile_time = _march(model, s, options, prefix, log, reactions)
     dyn, balance, solver = m.dyn, m.balance, m.solver
     growth = ErrorBased() if s.tolerance else EasyGrowth(1.5, s.easy_iterations, 2, clean=True)
     control = StepControl(s.dt, s.dt, m.dt_min, growth)
@@ -601,7 +617,7 @@ def solve_transient(
         h, wanted, report, cutbacks, error = _step(
             m, control, t, lambda t=t, step=step: save(t, step)
         )
-        energy = _accept(m, t, h, q_old)
+        energy = _accept(m, t, h, q_old, step + 1)
         t, step, iterations = t + h, step + 1, iterations + report.iterations
         record = StepRecord(step, t, h, report.iterations, report.residuals, cutbacks, energy)
         records.append(record)

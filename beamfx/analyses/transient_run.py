@@ -2,7 +2,8 @@
 
 Every step appends a row to ``probes.csv`` and a line to ``probes.jsonl`` (time, step size,
 Newton iterations, the probes' position, displacement and unwrapped rotation, and the
-energy balance); frames every ``output_every`` steps (or as ``[output]`` says); every
+energy balance); frames every ``output_every`` steps (or as ``[output]`` says), and at each
+frame a row of ``reactions.csv`` (:mod:`~beamfx.analyses.transient_reactions`); every
 ``checkpoint_every`` steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
@@ -119,6 +120,10 @@ class Result(_Base):
     restarted_from: float | None = entry("time of the checkpoint restarted from, or None")
     energy: dict | None = entry("energy balance at the last step")
     probe_history: dict = entry("the files of the probe history")
+    reaction_history: dict | None = entry(
+        "reactions.csv (the reactions at the output steps), its rows and the largest |force| "
+        "and |moment| of each support over the run with their times; None without rows"
+    )
     stopped_by: str = entry(
         '"t_end", or "interrupted by SIGINT" (SIGTERM) (a failed step raises, with its report)'
     )
@@ -290,12 +295,14 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     from ..interrupt import deferred
     from .restart import checkpoint_writer
     from .transient import TransientFailed, solve_transient
+    from .transient_reactions import ReactionSeries
 
     for w in motion_warnings(ctx.spec, settings.t_end):
         ctx.log(f"warning: {w}")
     saved = _start(model, settings, ctx)
     t_restart = saved[0]["t"] if saved else None
     history = History(ctx.folder, ctx.probes, ctx.comm, t_restart)
+    series = ReactionSeries(ctx.folder, ctx.comm, ctx.frames.want, t_restart)
     energy = {}
 
     def on_step(r):
@@ -318,6 +325,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
                 options=ctx.solver_options,
                 checkpoint=checkpoint_writer(ctx, settings, model, history),
                 saved=saved,
+                reactions=series,
             )
     except TransientFailed:  # collective; the model holds the last accepted state again
         ctx.probe_values(model)  # its full values, for results.json
@@ -325,6 +333,8 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     finally:
         bar.close()
         history.close()
+        series.close()
+        ctx.latest_reactions = series.entries()
     if result.steps:
         ctx.last_frame(result.steps[-1].step, result.steps[-1].time)
     ctx.probe_values(model)  # all the values at the final state, tracked as the history
@@ -341,6 +351,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         restarted_from=t_restart,
         energy=energy or None,
         probe_history={"csv": history.csv.name, "jsonl": history.jsonl.name},
+        reaction_history=series.summary() if series.latest is not None else None,
         stopped_by=result.stopped_by,
     )
 

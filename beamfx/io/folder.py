@@ -31,7 +31,7 @@ SYSTEM_FOLDERS = (
 )  # fmt: skip
 #: the files of a run (a fresh run removes them; see docs/scenes.md, "Files written in it")
 RUN_FILES = re.compile(
-    r"(results\.json|probes\.csv|probes\.jsonl|path\.csv|open_in_paraview\.py"
+    r"(results\.json|probes\.csv|probes\.jsonl|reactions\.csv|path\.csv|open_in_paraview\.py"
     r"|(deformed|surface)(_\d{4,}(_\d+)?\.(vtu|pvtu)|\.pvd|\.xdmf|\.h5)"
     r"|undeformed\.vtu|deformed\.png|mode_\d+\.png|animation\.gif"
     r"|checkpoint_\d+ranks_\d+\.npz|\.checkpoint_\d+ranks_\d+\.\d+\.tmp\.npz|\.tmp-.*\.json)"
