@@ -54,7 +54,7 @@ class Projection:
             self.M = fp.create_matrix(self.M_form)
         self.applies = not (
             dyn.settings.damping_mass or dyn.settings.damping_stiffness
-        ) and not any(s.history is not None for s in spec.supports)
+        ) and not any(s.timed for s in spec.supports)
         self.target = None  # (H_n, momenta g_n) of the last accepted state
 
     def _rigid_fields(self):

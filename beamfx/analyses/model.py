@@ -201,7 +201,7 @@ class BeamModel(Discretised):
                 dofs = fem.locate_dofs_topological(V, 0, verts)
                 c = fem.Constant(m, PETSc.ScalarType(value(0.0)))
                 bcs.append(fem.dirichletbc(c, dofs, V))
-                values.append((c, value, sup.history))
+                values.append((c, value, sup.history_of(sub)))
         return bcs, values
 
     def _support_targets(self, sup):

@@ -301,7 +301,7 @@ class EnergyBalance:
         self.f_loads = compile_form(dyn.loads) if dyn.loads is not None else None
         self.momenta = [compile_form(f) for f in dyn.momenta]
         self.residual = residual
-        self.moving = any(s.history is not None for s in m.spec.supports)
+        self.moving = any(s.timed for s in m.spec.supports)
         self.vec = fp.create_vector(self.residual)
         self.n_owned = owned_size(m.W)
         mask = np.zeros(len(m.w.x.array), bool)

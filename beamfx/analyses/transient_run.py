@@ -142,28 +142,37 @@ def motion_warnings(model, t_end, samples=4000):
     """
     out = []
     for i, sup in enumerate(model.supports):
-        f = sup.history
-        if f is None or not (any(sup.displacement) or any(sup.rotation)):
-            continue
-        kinks = []
-        for n in (samples, 2 * samples):
-            t = np.linspace(0.0, t_end, n + 1)
-            slope = np.diff(f(t)) / (t[1] - t[0])
-            kinks.append(np.max(np.abs(np.diff(slope)), initial=0.0))
-        scale = np.max(np.abs(f(np.linspace(0.0, t_end, 101)))) / t_end + 1e-300
-        dt0 = t_end / samples
-        slopes = [abs(float(f(d) - f(0.0))) / d for d in (dt0, dt0 / 2)]  # halves if smooth
-        start = abs(float(f(0.0))) > 1e-9 * scale * t_end or (
-            slopes[1] > 0.75 * slopes[0] and slopes[1] > 1e-6 * scale
-        )
-        if kinks[1] > 0.75 * kinks[0] and kinks[1] > 1e-6 * scale or start:
-            where = "at t = 0 (the run starts at rest)" if start else "inside the run"
-            out.append(
-                f"supports[{i}] at {sup.at!r}: the history {getattr(f, 'text', '')!r} jumps in "
-                f"value or slope {where}: that needs an infinite acceleration, and the "
-                "response will ring; smooth it (e.g. a (1 - cos) ramp)"
-            )
+        moved = [
+            sup.history_of(p) for p, v in enumerate((sup.displacement, sup.rotation)) if any(v)
+        ]
+        for f in dict.fromkeys(f for f in moved if f is not None):  # each distinct one once
+            out += _jumps(i, sup.at, f, t_end, samples)
     return out
+
+
+def _jumps(i, at, f, t_end, samples):
+    """The warning (a list of none or one) for a history ``f`` that jumps in value or slope."""
+    kinks = []
+    for n in (samples, 2 * samples):
+        t = np.linspace(0.0, t_end, n + 1)
+        slope = np.diff(f(t)) / (t[1] - t[0])
+        kinks.append(np.max(np.abs(np.diff(slope)), initial=0.0))
+    scale = np.max(np.abs(f(np.linspace(0.0, t_end, 101)))) / t_end + 1e-300
+    dt0 = t_end / samples
+    slopes = [abs(float(f(d) - f(0.0))) / d for d in (dt0, dt0 / 2)]  # halves if smooth
+    start = abs(float(f(0.0))) > 1e-9 * scale * t_end or (
+        slopes[1] > 0.75 * slopes[0] and slopes[1] > 1e-6 * scale
+    )
+    if not (kinks[1] > 0.75 * kinks[0] and kinks[1] > 1e-6 * scale or start):
+        return []
+    where = "at t = 0 (the run starts at rest)" if start else "inside the run"
+    text = getattr(f, "text", "")
+    message = (
+        f"supports[{i}] at {at!r}: the history {text!r} jumps in value or slope {where}: that "
+        "needs an infinite acceleration, and the response will ring; smooth it (e.g. a (1 - cos) "
+        "ramp)"
+    )
+    return [message]
 
 
 def _columns(probes):

@@ -210,7 +210,7 @@ def condensed_fit(model, analysis="static"):
     sup = model.supports[0]
     if set(sup.fix) != set(DOF_NAMES) or any(sup.displacement) or any(sup.rotation):
         return "the support is not a clamp with zero displacement and rotation"
-    if sup.history is not None or resolve_point(model, sup.at)[1] != 0.0:
+    if sup.timed or resolve_point(model, sup.at)[1] != 0.0:
         return "the clamp is not at the beam's start"
     if model.distributed_loads or any(model.gravity):
         return "distributed loads (and gravity) are not implemented in it"

@@ -23,6 +23,7 @@ def all_cases():
         nrel5mw_blade,
         pai_beam,
         pai_rotating,
+        pai_spin_ramp,
         planar_rollup,
         schwab_meijaard_2009,
         schwab_meijaard_eigen,

@@ -353,13 +353,16 @@ def _check_histories(model, settings, file, loads):
     timed += [(f"supports[{i}]", s) for i, s in enumerate(model.supports)]
     t = np.linspace(0.0, t_end, 1001)
     for where, item in timed:
-        if item.history is not None:
+        given = item.histories() if hasattr(item, "histories") else (("history", item.history),)
+        for key, f in given:
+            if f is None:
+                continue
             with np.errstate(all="ignore"):
-                values = np.asarray(item.history(t), float)
+                values = np.asarray(f(t), float)
             if not np.all(np.isfinite(values)):
                 bad = float(t[~np.isfinite(values)][0])
                 raise SceneError(
-                    f"{file}: {where}.history: not finite at t = {bad:g} (within [0, t_end]); "
+                    f"{file}: {where}.{key}: not finite at t = {bad:g} (within [0, t_end]); "
                     "allowed: a function finite over the whole run"
                 )
 

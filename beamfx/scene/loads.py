@@ -120,6 +120,25 @@ def _fix(t):
 read_fix = _fix  # ``fix`` of a table: also [[frames.supports]] (beamfx.scene.frames)
 
 
+def _check_support_histories(t, sup):
+    """``displacement_history`` / ``rotation_history``: each scales a prescribed value of its
+    own, in global axes, and not together with ``history`` (which would then scale nothing or
+    be ambiguous)."""
+    for key, values in (
+        ("displacement_history", sup.displacement),
+        ("rotation_history", sup.rotation),
+    ):
+        if getattr(sup, key) is None:
+            continue
+        part = key.split("_")[0]
+        if not any(values):
+            t.fail(key, f"there is no prescribed {part} to scale: give a non-zero '{part}'")
+        if sup.history is not None:
+            t.fail(key, "give either 'history' (both parts) or the per-part histories, not both")
+        if sup.axes == "local":
+            t.fail(key, "per-part histories need axes = 'global'")
+
+
 def read_supports(top):
     """``[[supports]]``: fixed dofs, prescribed motion."""
     supports = []
@@ -131,7 +150,10 @@ def read_supports(top):
             t.get("rotation", "vec3", (0.0,) * 3),
             t.get("axes", str, "global", choices=AXES),
             _history(t),
+            _history(t, "displacement_history"),
+            _history(t, "rotation_history"),
         )
+        _check_support_histories(t, sup)
         free = [
             DOF_NAMES[i] for i in range(3) if sup.displacement[i] and DOF_NAMES[i] not in sup.fix
         ]

@@ -36,7 +36,9 @@ class Support:
     and z the section's principal axes); the conditions are then stiff penalty springs
     (:meth:`BeamModel.penalty`), which leave a relative error of about 1e-9.
     ``displacement`` and ``rotation`` (a rotation vector) are prescribed values in the same
-    axes, applied with the load factor; zero by default.
+    axes, applied with the load factor; zero by default. In a transient, ``history`` f(t)
+    scales both; ``displacement_history`` and ``rotation_history``, when given, scale only
+    their own part instead (a hub that spins and is shaken: two schedules).
     """
 
     at: str
@@ -45,6 +47,23 @@ class Support:
     rotation: tuple = (0.0, 0.0, 0.0)
     axes: str = "global"
     history: object = None  # f(t) scaling displacement and rotation in a transient (None: 1)
+    displacement_history: object = None  # f(t) scaling the displacement only (None: history)
+    rotation_history: object = None  # f(t) scaling the rotation only (None: history)
+
+    def history_of(self, part):
+        """The history scaling ``part`` 0 (displacement) or 1 (rotation); None: constant."""
+        own = self.displacement_history if part == 0 else self.rotation_history
+        return self.history if own is None else own
+
+    def histories(self):
+        """(name, f) of every history given, in the order history, displacement, rotation."""
+        names = ("history", "displacement_history", "rotation_history")
+        return tuple((n, getattr(self, n)) for n in names if getattr(self, n) is not None)
+
+    @property
+    def timed(self):
+        """Whether a history moves this support in a transient."""
+        return bool(self.histories())
 
 
 @dataclass(frozen=True)
