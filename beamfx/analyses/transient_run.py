@@ -142,16 +142,21 @@ def motion_warnings(model, t_end, samples=4000):
     """
     out = []
     for i, sup in enumerate(model.supports):
-        moved = [
-            sup.history_of(p) for p, v in enumerate((sup.displacement, sup.rotation)) if any(v)
-        ]
-        for f in dict.fromkeys(f for f in moved if f is not None):  # each distinct one once
-            out += _jumps(i, sup.at, f, t_end, samples)
+        moved = {}  # each distinct history once, by its key
+        for part, (values, own) in enumerate(
+            ((sup.displacement, "displacement_history"), (sup.rotation, "rotation_history"))
+        ):
+            f = sup.history_of(part)
+            if any(values) and f is not None:
+                moved.setdefault(f, own if getattr(sup, own) is not None else "history")
+        for f, key in moved.items():
+            out += _jumps(f"supports[{i}] at {sup.at!r}: the {key}", f, t_end, samples)
     return out
 
 
-def _jumps(i, at, f, t_end, samples):
-    """The warning (a list of none or one) for a history ``f`` that jumps in value or slope."""
+def _jumps(where_key, f, t_end, samples):
+    """The warning (a list of none or one) for a history ``f`` that jumps in value or slope;
+    ``where_key`` names it."""
     kinks = []
     for n in (samples, 2 * samples):
         t = np.linspace(0.0, t_end, n + 1)
@@ -168,7 +173,7 @@ def _jumps(i, at, f, t_end, samples):
     where = "at t = 0 (the run starts at rest)" if start else "inside the run"
     text = getattr(f, "text", "")
     message = (
-        f"supports[{i}] at {at!r}: the history {text!r} jumps in value or slope {where}: that "
+        f"{where_key} {text!r} jumps in value or slope {where}: that "
         "needs an infinite acceleration, and the response will ring; smooth it (e.g. a (1 - cos) "
         "ramp)"
     )
