@@ -139,6 +139,8 @@ def trace_path(
         settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
     c0 = compile_seconds[0]
     u_dofs = subspace_dofs(model.W, 0)
+    if settings.geometric_arc_length is None:
+        settings = replace(settings, geometric_arc_length=geometric_arc_length(model, u_dofs))
     solver = ArcLengthSolver(
         model.F,
         model.J,
@@ -187,6 +189,24 @@ def trace_path(
 #: size: at 1e-2 the eigenvalue of the tangent that passed zero has grown to about 1e-4 of
 #: its scale on an Euler column's branch (far above round-off, so the inertia is certain)
 SWITCH_AMPLITUDE = 1e-2
+
+
+#: the geometric bound of a step: every measured dof moving by this fraction of the model's size
+#: (root mean square); below the steps of the shallow arch at its physical stiffness (0.5 %),
+#: so that the relative bound (10 first arc lengths) keeps deciding where it is the larger
+GEOMETRIC_FRACTION = 4e-3
+
+
+def geometric_arc_length(model, u_dofs):
+    """The arc length of a step that moves each measured dof (``u_dofs``, local indices) by
+    :data:`GEOMETRIC_FRACTION` of the model's size: the largest arc length a trace may always
+    reach, whatever the stiffness of its initial tangent (collective)."""
+    from mpi4py import MPI
+
+    index_map = model.W.dofmap.index_map
+    owned = index_map.size_local * model.W.dofmap.index_map_bs
+    count = model.comm.allreduce(int(np.count_nonzero(np.asarray(u_dofs) < owned)), op=MPI.SUM)
+    return GEOMETRIC_FRACTION * model_size(model) * float(np.sqrt(count))
 
 
 def model_size(model):
