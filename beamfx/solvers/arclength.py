@@ -57,7 +57,7 @@ import numpy as np
 
 from .assembly import assemble_load, assemble_residual, assemble_tangent
 from .bifurcation import CriticalPoint, classify, locate, smallest_eigenpair
-from .convergence import FLOOR_FACTOR, ScaledTest, diagnose, remedy
+from .convergence import ScaledTest, diagnose, remedy
 from .forms import compile_form
 from .inertia import InertiaCounter, counts_inertia, negative_pivots, prepare
 from .options import petsc_options
@@ -224,7 +224,6 @@ class ArcLengthSolver:
         self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
         self._cached, self._prepared = None, False
-        self.effort = 0  # iterations of the last converged step for the step size (_effort)
 
         n_owned = (
             w.function_space.dofmap.index_map.size_local * w.function_space.dofmap.index_map_bs
@@ -377,7 +376,6 @@ class ArcLengthSolver:
         for it in range(s.max_iterations + 1):
             residuals.append(self._residual(lam_n + dlam))
             if self._converged(it, residuals[-1], lam_n + dlam, ddlam):
-                self.effort = self._effort(it)
                 return dw, dlam, it, tuple(residuals)
             if residuals[-1] > s.divergence * residuals[0]:
                 raise self._failed("DIVERGED_DTOL", "diverged", residuals)
@@ -421,21 +419,6 @@ class ArcLengthSolver:
         if how == "nan":
             raise self._failed("DIVERGED_FNORM_NAN", "the residual is not finite", [fnorm])
         return how is not None
-
-    def _effort(self, iterations):
-        """The iterations of a converged step that measure the path's nonlinearity, for the
-        step-size rule: all of them, but for a step converged at the round-off floor only the
-        corrections that brought the residual to the floor (at least 2, the fewest a step
-        converged by the residual criterion takes), as the residual criterion counts those
-        that brought it to the tolerance. The further corrections only confirm that the
-        increments settled at the floor (the increment criteria need three of them): they
-        measure round-off, not the curvature of the path, and counting them keeps the steps
-        small where a stiff term (EA, GA ≫ EI/L²) raises the floor."""
-        if self.test.how != "floor" or not self.test.floor:
-            return iterations
-        at = FLOOR_FACTOR * self.test.floor
-        reached = next(i for i, r in enumerate(self.test.records) if r["fnorm"] <= at)
-        return min(iterations, max(2, reached))
 
     def _failed(self, reason, why, residuals):
         """_StepFailed of a corrector that stopped with the PETSc-named ``reason``: the cause
@@ -525,7 +508,6 @@ class ArcLengthSolver:
             if taken is None:
                 continue
             dw, dlam, its, res = taken
-            effort = self.effort
             reached = target_load_factor is not None and (
                 (path.lam - target_load_factor) * (path.lam + dlam - target_load_factor) < 0
                 or path.lam + dlam == target_load_factor
@@ -542,7 +524,7 @@ class ArcLengthSolver:
             if stop is not None and stop(path.steps[-1]):
                 reason = "stop"
                 break
-            path.control.accepted(effort)
+            path.control.accepted(its)
         saved.destroy()
         self.lam.value = path.lam
         seconds = {**self.seconds, "total": time.perf_counter() - t_start}
