@@ -132,15 +132,9 @@ def trace_path(
             )
         comp = DOF_NAMES.index(comp)
 
-    follower = state_dependent_loads(model)
-    base = settings or ArcLengthSettings()
-    settings = replace(base, follower=base.follower or follower)
-    if settings.switch_amplitude is None:  # far enough from the bifurcation for its inertia
-        settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
-    c0 = compile_seconds[0]
     u_dofs = subspace_dofs(model.W, 0)
-    if settings.geometric_arc_length is None:
-        settings = replace(settings, geometric_arc_length=geometric_arc_length(model, u_dofs))
+    settings = _model_settings(model, settings or ArcLengthSettings(), u_dofs)
+    c0 = compile_seconds[0]
     solver = ArcLengthSolver(
         model.F,
         model.J,
@@ -183,6 +177,17 @@ def trace_path(
     return ContinuationResult(
         tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
     )
+
+
+def _model_settings(model, settings, u_dofs):
+    """``settings`` with what the model decides: follower loads, and the defaults of the
+    switch amplitude and of the geometric bound of a step (collective)."""
+    settings = replace(settings, follower=settings.follower or state_dependent_loads(model))
+    if settings.switch_amplitude is None:  # far enough from the bifurcation for its inertia
+        settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
+    if settings.geometric_arc_length is None:
+        settings = replace(settings, geometric_arc_length=geometric_arc_length(model, u_dofs))
+    return settings
 
 
 #: default arc length of the first step onto a secondary branch, as a fraction of the model's
