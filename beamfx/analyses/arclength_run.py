@@ -43,7 +43,10 @@ class Settings:
         doc="stop when the control point's displacement component passes the value",
     )
     max_arc_length: float | None = option(
-        None, positive=True, doc="largest arc length of a step (default: 10 first arc lengths)"
+        None,
+        positive=True,
+        doc="largest arc length of a step (default: 10 first arc lengths, and at least a step "
+        "moving every displacement dof by 0.4 % of the model's size)",
     )
     min_arc_length: float | None = option(
         None, positive=True, doc="smallest arc length before failing (default: 1e-4 of the first)"

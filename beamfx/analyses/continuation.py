@@ -132,13 +132,9 @@ def trace_path(
             )
         comp = DOF_NAMES.index(comp)
 
-    follower = state_dependent_loads(model)
-    base = settings or ArcLengthSettings()
-    settings = replace(base, follower=base.follower or follower)
-    if settings.switch_amplitude is None:  # far enough from the bifurcation for its inertia
-        settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
-    c0 = compile_seconds[0]
     u_dofs = subspace_dofs(model.W, 0)
+    settings = _model_settings(model, settings or ArcLengthSettings(), u_dofs)
+    c0 = compile_seconds[0]
     solver = ArcLengthSolver(
         model.F,
         model.J,
@@ -183,10 +179,39 @@ def trace_path(
     )
 
 
+def _model_settings(model, settings, u_dofs):
+    """``settings`` with what the model decides: follower loads, and the defaults of the
+    switch amplitude and of the geometric bound of a step (collective)."""
+    settings = replace(settings, follower=settings.follower or state_dependent_loads(model))
+    if settings.switch_amplitude is None:  # far enough from the bifurcation for its inertia
+        settings = replace(settings, switch_amplitude=SWITCH_AMPLITUDE * model_size(model))
+    if settings.geometric_arc_length is None:
+        settings = replace(settings, geometric_arc_length=geometric_arc_length(model, u_dofs))
+    return settings
+
+
 #: default arc length of the first step onto a secondary branch, as a fraction of the model's
 #: size: at 1e-2 the eigenvalue of the tangent that passed zero has grown to about 1e-4 of
 #: its scale on an Euler column's branch (far above round-off, so the inertia is certain)
 SWITCH_AMPLITUDE = 1e-2
+
+
+#: the geometric bound of a step: every measured dof moving by this fraction of the model's size
+#: (root mean square); below the steps of the shallow arch at its physical stiffness (0.5 %),
+#: so that the relative bound (10 first arc lengths) keeps deciding where it is the larger
+GEOMETRIC_FRACTION = 4e-3
+
+
+def geometric_arc_length(model, u_dofs):
+    """The arc length of a step that moves each measured dof (``u_dofs``, local indices) by
+    :data:`GEOMETRIC_FRACTION` of the model's size: the largest arc length a trace may always
+    reach, whatever the stiffness of its initial tangent (collective)."""
+    from mpi4py import MPI
+
+    index_map = model.W.dofmap.index_map
+    owned = index_map.size_local * model.W.dofmap.index_map_bs
+    count = model.comm.allreduce(int(np.count_nonzero(np.asarray(u_dofs) < owned)), op=MPI.SUM)
+    return GEOMETRIC_FRACTION * model_size(model) * float(np.sqrt(count))
 
 
 def model_size(model):

@@ -86,6 +86,12 @@ class ArcLengthSettings:
         desired_iterations: I_d of the step-size rule Δl_new = Δl (I_d / I)^½.
         max_growth: bound on Δl_new / Δl after a converged step.
         min_arc_length, max_arc_length: bounds on Δl, as multiples of the first arc length.
+        geometric_arc_length: a Δl the steps may always grow to (units of the measured dofs):
+            the default largest Δl is the larger of ``max_arc_length`` first arc lengths and
+            this. The first arc length comes from the initial tangent, which a stiff axial or
+            shear term (EA, GA ≫ EI/L²: a shallow arch's membrane state) makes tiny; without
+            a geometric bound the whole path would be traced in steps of that size. None: the
+            relative bound alone.
         bounds: (smallest, largest) Δl in the units of the measured dofs; an entry given
             replaces the relative bound.
         inertia: count the negative eigenvalues of the tangent at every converged state
@@ -109,6 +115,7 @@ class ArcLengthSettings:
     min_arc_length: float = 1e-4
     max_arc_length: float = 10.0
     bounds: tuple = (None, None)
+    geometric_arc_length: float | None = None
     inertia: bool = True
     branch: str = "primary"
     switch_amplitude: float | None = None
@@ -530,7 +537,8 @@ class ArcLengthSolver:
         s = self.settings
         smallest, largest = s.bounds
         smallest = s.min_arc_length * dl0 if smallest is None else smallest
-        largest = s.max_arc_length * dl0 if largest is None else largest
+        if largest is None:
+            largest = max(s.max_arc_length * dl0, s.geometric_arc_length or 0.0)
         growth = IterationRatio(s.desired_iterations, 0.5, s.max_growth)
         return StepControl(min(max(dl0, smallest), largest), largest, smallest, growth)
 

@@ -22,7 +22,8 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
   ‖du‖ ≤ :data:`INCREMENT_TOL`·‖|x| + s‖ (or :data:`SETTLED_TOL`·‖|x| + s‖ once the
   corrections stagnate: round-off moves the state, Newton no longer does), and its
   energy is small, |du·F| ≤ :data:`ENERGY_TOL`·E
-  with E the larger of the solve's largest correction energy and the state's |x·Kx|;
+  with E the largest of the solve's largest correction energy, the state's |x·Kx| and the
+  floor's energy over the state's size, floor·‖|x| + s‖ (what round-off resolves);
 * **relative** (only if ``snes_rtol`` is given in ``[solver]``): ‖F‖ ≤ rtol·‖F₀‖ and the
   increment criteria hold.
 
@@ -283,7 +284,11 @@ class ScaledTest:
         if self.state_energy is None:
             self.solver.A.mult(x, self.Kx)
             self.state_energy = abs(x.dot(self.Kx))
-        record["reference"] = max(self.first_energy, self.state_energy)
+        # the energy resolvable at all: the floor's forces over the state's size (a state far
+        # smaller than the reference geometry, e.g. the first arc-length step of a stiff model,
+        # has |x·Kx| below it, and corrections at round-off then fail against |x·Kx|)
+        resolvable = (self.floor or 0.0) * self.state_norm
+        record["reference"] = max(self.first_energy, self.state_energy, resolvable)
         return record["energy"] <= ENERGY_TOL * record["reference"]
 
     def allowed(self, record, x):
