@@ -52,20 +52,31 @@ OUT = Path("docs/validation/stress_matrix.md")
 
 @contextmanager
 def stiffened(factor):
-    """EA, GA_y and GA_z multiplied by ``factor`` in every section the models read."""
-    from ..physics import sections
+    """EA, GA_y and GA_z multiplied by ``factor`` in every section the models read. A 6×6
+    matrix section becomes D C D with D = diag(√f, √f, √f, 1, 1, 1): its force block times f,
+    its force–moment coupling times √f (positive definite as C is; the diagonal case is EA, GA
+    times f)."""
+    from ..physics import matrix_sections, sections
 
     original = sections.Section.stiffnesses
+    original_matrices = matrix_sections.MatrixSection.matrices_at
+    d = np.r_[np.full(3, np.sqrt(factor)), np.ones(3)]
 
     def scaled(self):
         s = original(self)
         return np.r_[s[:3] * factor, s[3:]]
 
+    def scaled_matrices(self, s):
+        C, M = original_matrices(self, s)
+        return C * d[:, None] * d[None, :], M
+
     sections.Section.stiffnesses = scaled
+    matrix_sections.MatrixSection.matrices_at = scaled_matrices
     try:
         yield
     finally:
         sections.Section.stiffnesses = original
+        matrix_sections.MatrixSection.matrices_at = original_matrices
 
 
 def settings_by_degree(case):

@@ -2,6 +2,8 @@
 
 from types import SimpleNamespace
 
+import numpy as np
+
 from beamfx.bench import stress_matrix as sm
 
 
@@ -101,3 +103,22 @@ def test_a_rerun_replaces_its_cases_rows_in_place():
         (b, (1, 2), "old b"),
         (c, (1, 2), "new c"),
     ]
+
+
+def test_the_factor_reaches_matrix_sections_as_a_congruence():
+    """A 6x6 section under the matrix's factor: force block times f, coupling times sqrt f,
+    moment block unchanged (so a coupled section stays positive definite)."""
+    from beamfx.bench.stress_matrix import stiffened
+    from beamfx.physics.matrix_sections import MatrixSection
+
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(6, 6))
+    C = A @ A.T + 6 * np.eye(6)
+    section = MatrixSection(np.array([C]), np.array([np.eye(6)]), (0.0,), 1.0, False)
+    base, _ = section.matrices_at([0.5])
+    with stiffened(100.0):
+        scaled, _ = section.matrices_at([0.5])
+    assert np.allclose(scaled[0][:3, :3], 100 * base[0][:3, :3])
+    assert np.allclose(scaled[0][:3, 3:], 10 * base[0][:3, 3:])
+    assert np.allclose(scaled[0][3:, 3:], base[0][3:, 3:])
+    assert np.all(np.linalg.eigvalsh(scaled[0]) > 0)
