@@ -74,7 +74,7 @@ def test_markdown_toml_blocks_become_scene_files_beside_the_geo_blocks(tmp_path)
 def test_folders_give_their_toml_files():
     sources = scene_sources([ROOT / "demos" / "scenes"], None)
     names = {s.path.name for s in sources}
-    frames = {"dome.toml", "lattice.toml", "tower.toml"}
+    frames = {"dome.toml", "lattice.toml", "tower.toml", "star_dome.toml", "lattice_buckling.toml"}
     assert names == {"prestress_sweep.toml", "spin_up.toml", "channel_cantilever.toml"} | frames
 
 
