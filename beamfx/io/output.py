@@ -169,6 +169,7 @@ class FrameWriter:
         points = spec is not None and bool(spec.supports or spec.springs)
         self.has_reactions = "reactions" in settings.formats and points
         self.reactions = None  # rank 0: the series of the reactions
+        self.reaction_frames = 0  # frames of it written (counted on every rank)
         if self.has_reactions and self.comm.rank == 0:
             from mpi4py import MPI
 
@@ -195,8 +196,11 @@ class FrameWriter:
         from .fields import local_fields
         from .vtkfiles import lagrange_line_grid
 
-        if self.reactions is not None and reactions:
-            self.reactions.write(step, time, reaction_grid(reactions, self.grids["reactions"]))
+        if self.has_reactions and reactions:
+            self.reaction_frames += 1
+            if self.reactions is not None:
+                grid = reaction_grid(reactions, self.grids["reactions"])
+                self.reactions.write(step, time, grid)
         if not self.series and self.xdmf is None:  # formats = []: nothing to write
             self.policy.record(step, time)
             return
@@ -263,7 +267,7 @@ class FrameWriter:
             out["xdmf"] = "deformed.xdmf"
         if "surface" in self.series:
             out["surface"] = "surface.pvd"
-        if self.has_reactions:
+        if self.reaction_frames:
             out["reactions"] = "reactions.pvd"
         if "deformed" in self.series:
             out["script"] = SCRIPT

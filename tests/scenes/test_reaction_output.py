@@ -44,16 +44,16 @@ def read_vtu(path):
     reader.Update()
     grid = reader.GetOutput()
     pd = grid.GetPointData()
-    arrays = {pd.GetArrayName(i): vtk_to_numpy(pd.GetArray(i)) for i in range(pd.GetNumberOfArrays())}
+    arrays = {
+        pd.GetArrayName(i): vtk_to_numpy(pd.GetArray(i)) for i in range(pd.GetNumberOfArrays())
+    }
     return vtk_to_numpy(grid.GetPoints().GetData()), arrays
 
 
 def row_reactions(row, points):
     """{point: (force, moment, position)} of a CSV row."""
     return {
-        at: tuple(
-            np.array([row[f"{at}_{k}{c}"] for c in "xyz"]) for k in ("f", "m", "")
-        )
+        at: tuple(np.array([row[f"{at}_{k}{c}"] for c in "xyz"]) for k in ("f", "m", ""))
         for at in points
     }
 
@@ -173,6 +173,30 @@ def test_no_supports_no_reactions_series(tmp_path):
 
     from mpi4py import MPI
 
-    writer = FrameWriter(tmp_path, Model(), OutputSettings(formats=("reactions",)), [], MPI.COMM_SELF)
+    writer = FrameWriter(
+        tmp_path, Model(), OutputSettings(formats=("reactions",)), [], MPI.COMM_SELF
+    )
     assert writer.reactions is None and "reactions" not in writer.files()
     writer.close()
+
+
+def test_reaction_series_files_are_run_files(tmp_path):
+    """reactions.pvd and its frames are a run's files: a fresh run removes the index, keeps
+    the frames to write over in place, and a link of such a name is removed, never followed."""
+    from beamfx.io.folder import FRAME_FILES, RUN_FILES, clear_earlier_run
+
+    assert RUN_FILES.fullmatch("reactions.pvd") and RUN_FILES.fullmatch("reactions_0012.vtu")
+    assert FRAME_FILES.fullmatch("reactions_0012.vtu") and not FRAME_FILES.fullmatch(
+        "reactions.pvd"
+    )
+    assert not RUN_FILES.fullmatch("reactions_0012.pvtu")  # rank 0 alone writes them
+    outside = tmp_path / "outside.txt"
+    outside.write_text("keep me")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "reactions.pvd").write_text("old")
+    (out / "reactions_0001.vtu").write_text("old")
+    (out / "reactions_0002.vtu").symlink_to(outside)
+    removed, frames = clear_earlier_run(out, restart=False)
+    assert sorted(removed) == ["reactions.pvd", "reactions_0002.vtu"]
+    assert list(frames) == ["reactions_0001.vtu"] and outside.read_text() == "keep me"
