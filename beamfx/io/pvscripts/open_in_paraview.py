@@ -8,8 +8,9 @@ centre line, coloured by |u|, over the undeformed centre line in grey.
 
 Without a display (Debian's ParaView renders through X only) prefix ``xvfb-run -a``. Runs in
 ParaView's own Python: it imports nothing from beamfx. Reads ``deformed.pvd`` (the centre
-line, arrays X, u, e1..e3, N, M) and ``surface.pvd`` (the surface, arrays u, N, M) beside it,
-or in the folder given with ``--dir``.
+line, arrays X, u, e1..e3, N, M), ``surface.pvd`` (the surface, arrays u, N, M) and
+``reactions.pvd`` (the supports, drawn as red dots; arrays force, moment) where present, beside
+it or in the folder given with ``--dir``.
 """
 
 import argparse
@@ -106,6 +107,17 @@ def show_results(folder, view=None, time=None):
     bar.TitleFontSize, bar.LabelFontSize = 18, 16
     bar.RangeLabelFormat = "%-#.3g"
     out["display"] = disp
+
+    reactions_file = os.path.join(folder, "reactions.pvd")
+    if os.path.exists(reactions_file):  # the supports: red dots (arrays force, moment)
+        reactions = pvs.PVDReader(FileName=reactions_file)
+        dots = pvs.Show(reactions, view)
+        dots.SetRepresentationType("Points")
+        dots.ColorArrayName = ["POINTS", ""]
+        dots.AmbientColor = dots.DiffuseColor = (0.8, 0.1, 0.1)
+        dots.PointSize = 12.0
+        dots.RenderPointsAsSpheres = 1
+        out["reactions"] = reactions
 
     name = os.path.basename(os.path.abspath(folder))
     label = pvs.Text(Text=f"{name}: {_time_label(folder, time)}")
