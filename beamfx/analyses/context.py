@@ -77,7 +77,7 @@ class RunContext:
     def reaction_row(self, step, time, entry):
         """A row of ``reactions.csv`` (the transient's columns without the inertia; ``time``:
         the load factor), the file started at the first row (rank 0 writes). Collective."""
-        from .transient_reactions import ReactionCsv, columns, static_row
+        from ..io.reaction_files import ReactionCsv, columns, static_row
 
         if self._reaction_csv is None:
             self._reaction_csv = ReactionCsv(self.folder / "reactions.csv", self.comm)

@@ -199,6 +199,8 @@ class FrameWriter:
         if self.has_reactions and reactions:
             self.reaction_frames += 1
             if self.reactions is not None:
+                from .reaction_files import reaction_grid
+
                 grid = reaction_grid(reactions, self.grids["reactions"])
                 self.reactions.write(step, time, grid)
         if not self.series and self.xdmf is None:  # formats = []: nothing to write
@@ -274,22 +276,6 @@ class FrameWriter:
         return out
 
 
-def reaction_grid(reactions, build=None):
-    """The grid of the reactions: a vertex per point at its ``position``, point arrays
-    ``force`` and ``moment`` ((n, 3), global axes); made by ``build`` (a
-    :class:`~beamfx.io.vtkfiles.GridBuffer`, else a new grid)."""
-    from .vtkfiles import VTK_VERTEX, unstructured_grid
-
-    rows = list(reactions.values())
-    n = len(rows)
-    data = {
-        key: np.array([r[key] for r in rows], float).reshape(n, 3) for key in ("force", "moment")
-    }
-    points = np.array([r["position"] for r in rows], float).reshape(n, 3)
-    cells = (np.arange(n), np.arange(n + 1), np.full(n, VTK_VERTEX))
-    return (build or unstructured_grid)(points, *cells, data)
-
-
 def _reached(time, target):
     return time >= target - 1e-9 * max(1.0, abs(target))
 
@@ -311,11 +297,4 @@ def write_paraview_script(folder, comm):
     os.replace(tmp, target)
 
 
-__all__ = [
-    "FramePolicy",
-    "FrameWriter",
-    "OutputSettings",
-    "default_every",
-    "prepare_output",
-    "reaction_grid",
-]
+__all__ = ["FramePolicy", "FrameWriter", "OutputSettings", "default_every", "prepare_output"]
