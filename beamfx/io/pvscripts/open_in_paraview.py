@@ -108,15 +108,8 @@ def show_results(folder, view=None, time=None):
     bar.RangeLabelFormat = "%-#.3g"
     out["display"] = disp
 
-    reactions_file = os.path.join(folder, "reactions.pvd")
-    if os.path.exists(reactions_file):  # the supports: red dots (arrays force, moment)
-        reactions = pvs.PVDReader(FileName=reactions_file)
-        dots = pvs.Show(reactions, view)
-        dots.SetRepresentationType("Points")
-        dots.ColorArrayName = ["POINTS", ""]
-        dots.AmbientColor = dots.DiffuseColor = (0.8, 0.1, 0.1)
-        dots.PointSize = 12.0
-        dots.RenderPointsAsSpheres = 1
+    reactions = show_reactions(folder, view)
+    if reactions is not None:
         out["reactions"] = reactions
 
     name = os.path.basename(os.path.abspath(folder))
@@ -140,6 +133,22 @@ def show_results(folder, view=None, time=None):
     disp.RescaleTransferFunctionToDataRange(False, True)
     fit_camera(view)
     return out
+
+
+def show_reactions(folder, view):
+    """Show ``reactions.pvd`` of ``folder`` (the supports; arrays force, moment) as red dots;
+    its reader, or None if there is none."""
+    path = os.path.join(folder, "reactions.pvd")
+    if not os.path.exists(path):
+        return None
+    reactions = pvs.PVDReader(FileName=path)
+    dots = pvs.Show(reactions, view)
+    dots.SetRepresentationType("Points")
+    dots.ColorArrayName = ["POINTS", ""]
+    dots.AmbientColor = dots.DiffuseColor = (0.8, 0.1, 0.1)
+    dots.PointSize = 12.0
+    dots.RenderPointsAsSpheres = 1
+    return reactions
 
 
 def fit_camera(view, direction=VIEW_DIRECTION, up=VIEW_UP, zoom=0.95):
