@@ -226,3 +226,22 @@ def test_restart_cuts_and_continues_the_reaction_series(tmp_path):
         for key in ("force", "moment"):
             assert np.allclose(a[1][key], b[1][key], rtol=1e-9, atol=1e-9 * scale)
     assert sorted(p.name for p in (tmp_path / "parts").glob("reactions_*")) == [f for _, f in whole]
+
+
+def test_condensed_cantilever_rows_have_no_balance(scene_file, tmp_path):
+    """The statically condensed model reports the clamp's reaction from the section
+    resultants and no balance: its rows hold the reactions, NaN in the balance cells, and its
+    frames the reactions of results.json."""
+    text = CANTILEVER.replace("KIN", "finite").replace("CONDENSE", "auto")
+    out = tmp_path / "out"
+    run = run_scene(scene_file(text), out, log=_quiet)
+    assert run["model"]["condensed"] and run["reaction_balance"] is None
+    saved = json.loads((out / "results.json").read_text())
+    rows = csv_rows(out)
+    assert len(rows) == len(saved["path"]) == 2
+    for row, point in zip(rows, saved["path"]):
+        assert_row_equals(row, point["reactions"])
+        assert np.isnan(row["balance_force"]) and np.isnan(row["applied_f_x"])
+    frames = pvd_frames(out / "reactions.pvd")
+    assert len(frames) == 2
+    assert_frame_equals(out, frames[-1][1], saved["reactions"])
