@@ -111,6 +111,7 @@ def run_scene(
         ctx = _context(scene, out, comm, log, restart, png or animate)
         result = _analyse(analysis(scene.analysis), scene, ctx, log)
         ctx.frames.close()
+        ctx.close()
         run = RunResult(
             str(path),
             result,

@@ -1,5 +1,6 @@
 """Arc-length continuation of a scene (``[analysis] type = "arclength"``): the equilibrium path
-through limit points, written to ``path.csv`` as it goes, its limit points in the results; the
+through limit points, written to ``path.csv`` (and the reactions to ``reactions.csv``, a row per
+accepted point) as it goes, its limit points in the results; the
 inertia of the tangent at every point, the critical points it passes, bifurcations located and
 (``branch = "secondary"``) the secondary branch followed from the first one."""
 

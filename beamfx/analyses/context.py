@@ -42,6 +42,7 @@ class RunContext:
     latest: dict | None = None  # probe values of the last accepted state, tracked
     _points: list | None = field(default=None, init=False, repr=False)  # the probes' points
     latest_reactions: dict | None = None  # results.json entries of the last reactions
+    _reaction_csv: object = field(default=None, init=False, repr=False)  # reactions.csv
 
     def reactions(self, model):
         """Support reactions and their balance with the loads at the model's current state
@@ -66,11 +67,28 @@ class RunContext:
         return self.latest
 
     def step(self, model, step, time):
-        """After an accepted step: probes tracked, and a frame where the output asks."""
+        """After an accepted step (static, arc length): probes tracked, the reactions (a row
+        of ``reactions.csv``), and a frame where the output asks."""
         self.probe_values(model)
-        self.reactions(model)
+        self.reaction_row(step, time, self.reactions(model))
         if self.frames.want(step, time):
-            self.frames.write(step, time)
+            self.frames.write(step, time, self.latest_reactions["reactions"])
+
+    def reaction_row(self, step, time, entry):
+        """A row of ``reactions.csv`` (the transient's columns without the inertia; ``time``:
+        the load factor), the file started at the first row (rank 0 writes). Collective."""
+        from ..io.reaction_files import ReactionCsv, columns, static_row
+
+        if self._reaction_csv is None:
+            self._reaction_csv = ReactionCsv(self.folder / "reactions.csv", self.comm)
+            self._reaction_csv.start(columns(list(entry["reactions"]), transient=False))
+        self._reaction_csv.write(static_row(step, time, entry))
+
+    def close(self):
+        """Close the files the context keeps open (``reactions.csv``)."""
+        if self._reaction_csv is not None:
+            self._reaction_csv.close()
+        self._reaction_csv = None
 
     def require_mass(self, model, analysis):
         """Raise (naming the scene) if the model has no mass: no density and no point mass."""
@@ -85,15 +103,20 @@ class RunContext:
                 "and rho_I of the general sections, or [[masses]]"
             )
 
-    def last_frame(self, step, time):
-        """The last step of a run always gets a frame (if ``every`` skipped it)."""
+    def last_frame(self, step, time, reactions=None):
+        """The last step of a run always gets a frame (if ``every`` skipped it), with
+        ``reactions`` ({point: {force, moment, position}}; default: the latest of
+        :meth:`reactions`)."""
+        if reactions is None and self.latest_reactions is not None:
+            reactions = self.latest_reactions["reactions"]
         if self.frames.want(step, time, last=True):
-            self.frames.write(step, time)
+            self.frames.write(step, time, reactions)
 
     def fallback(self):
         """The full model instead of the condensed one: the failed attempt's probes and frames
         are forgotten, and the new model is returned (and kept as :attr:`model`)."""
         self.latest = self.latest_reactions = None
+        self.close()  # reactions.csv starts again at the new model's first step
         self.frames.resume(0.0)
         self.model, self.rebuild = self.rebuild(), None
         self.frames.follow(self.model)

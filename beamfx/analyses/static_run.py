@@ -1,6 +1,6 @@
 """Static analyses of a scene: ``static`` (nonlinear, adaptive load stepping to load factor 1)
-and ``linear_static`` (linear kinematics, one solve). A frame and the probes after every
-accepted load step."""
+and ``linear_static`` (linear kinematics, one solve). A frame (with the reactions' frame), the
+probes and a row of ``reactions.csv`` after every accepted load step."""
 
 from dataclasses import dataclass
 from typing import TYPE_CHECKING

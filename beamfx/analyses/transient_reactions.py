@@ -28,17 +28,18 @@ no residual of its own: no reactions are reported for it.
 **When.** The reactions cost two vector assemblies (inertia and loads) and a few reductions, so
 they are taken at the output steps only (the ParaView frames: ``output_every``, ``[output]
 every``/``times``) and at the last step; each is a row of ``reactions.csv`` appended as the run
-goes (rank 0), and ``results.json`` keeps the last one and the largest values over the run.
+goes (rank 0; the writer a static run uses too, :mod:`beamfx.io.reaction_files`), a frame of
+``reactions.pvd`` beside the other frames of the step, and ``results.json`` keeps the last one
+and the largest values over the run.
 """
 
 from typing import NamedTuple
 
 import numpy as np
 
+from ..io.reaction_files import ReactionCsv, columns
 from .dofs import constrained_dofs, owned_size
 from .reactions import ReactionRecovery
-
-AXES = ("x", "y", "z")
 
 
 class DynamicBalance(NamedTuple):
@@ -111,17 +112,6 @@ class TransientReactions:
         return reactions, balance
 
 
-def columns(points):
-    """The header of ``reactions.csv``: step, time; per point the force, the moment about it
-    and its position; the applied and inertia resultants (about the origin); the balance."""
-    cols = ["step", "time"]
-    for at in points:
-        cols += [f"{at}_{k}{c}" for k in ("f", "m") for c in AXES]
-        cols += [f"{at}_{c}" for c in AXES]
-    cols += [f"{k}_{c}" for k in ("applied_f", "applied_m", "inertia_f", "inertia_m") for c in AXES]
-    return cols + ["balance_force", "balance_moment", "free_residual"]
-
-
 def _row(step, time, reactions, balance):
     row = [step, time]
     for r in reactions.values():
@@ -176,33 +166,16 @@ class ReactionSeries:
     def __init__(self, folder, comm, want, t_restart=None):
         self.path, self.comm, self.want = folder / "reactions.csv", comm, want
         self.t_restart = t_restart
-        self.compute = self.file = self.latest = None
+        self.csv = ReactionCsv(self.path, comm)
+        self.compute = self.latest = None
 
     def start(self, dyn, residual):
         """Compile what the reactions need; start (or cut back) the file. Collective."""
         self.compute = TransientReactions(dyn, residual)
         points = list(self.compute.recovery.points)
         self.peaks = Peaks(points)
-        header = columns(points)
-        self.row_format = ",".join(["{:.12g}"] * len(header)) + "\n"
-        kept = self._kept(",".join(header)) if self.t_restart is not None else []
-        for cells in self.comm.bcast(kept if self.comm.rank == 0 else None):
+        for cells in self.csv.start(columns(points), self.t_restart):
             self.peaks.add_csv_row(cells)
-        if self.comm.rank == 0:
-            if self.t_restart is None:
-                self.path.write_text(",".join(header) + "\n")
-            self.file = self.path.open("a")
-
-    def _kept(self, header):
-        """Rows up to the checkpoint (rank 0): the file rewritten with them; their cells."""
-        if self.comm.rank != 0:
-            return []
-        rows = self.path.read_text().splitlines()[1:] if self.path.exists() else []
-        t_max, n = self.t_restart * (1 + 1e-12), header.count(",") + 1
-        kept = [r.split(",") for r in rows if len(r.split(",")) == n]
-        kept = [c for c in kept if float(c[1]) <= t_max]
-        self.path.write_text("".join(",".join(c) + "\n" for c in [header.split(","), *kept]))
-        return kept
 
     def __call__(self, step, time, last, residual):
         """The reactions of a converged step, if it is an output step. Collective."""
@@ -213,15 +186,18 @@ class ReactionSeries:
         moments = {at: r.moment for at, r in reactions.items()}
         self.peaks.add(time, forces, moments, (balance.force, balance.moment))
         self.latest = (step, time, reactions, balance)
-        if self.file:  # flushed: a row costs little beside the frame of the same step
-            self.file.write(self.row_format.format(*_row(step, time, reactions, balance)))
-            self.file.flush()
+        self.csv.write(_row(step, time, reactions, balance))
+
+    def at_step(self, step):
+        """``{point: {force, moment, position}}`` of output step ``step`` if its reactions
+        were taken (the ParaView frame of the step), else None."""
+        if self.latest is None or self.latest[0] != step:
+            return None
+        return {at: r._asdict() for at, r in self.latest[2].items()}
 
     def close(self):
         """Close the file (rank 0)."""
-        if self.file:
-            self.file.close()
-        self.file = None
+        self.csv.close()
 
     def entries(self):
         """``reactions`` and ``reaction_balance`` of ``results.json`` at the last output step

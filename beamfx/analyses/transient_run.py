@@ -325,7 +325,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         history.add(r, values)
         if ctx.frames.want(r.step, r.time):
             history.flush()
-            ctx.frames.write(r.step, r.time)
+            ctx.frames.write(r.step, r.time, series.at_step(r.step))
 
     bar, progress = _progress(model.comm, settings.t_end)
     try:
@@ -350,7 +350,8 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         series.close()
         ctx.latest_reactions = series.entries()
     if result.steps:
-        ctx.last_frame(result.steps[-1].step, result.steps[-1].time)
+        last = result.steps[-1]
+        ctx.last_frame(last.step, last.time, series.at_step(last.step) or {})
     ctx.probe_values(model)  # all the values at the final state, tracked as the history
     stopped = result.stopped_by != "t_end"
     return Result(

@@ -33,12 +33,13 @@ SYSTEM_FOLDERS = (
 RUN_FILES = re.compile(
     r"(results\.json|probes\.csv|probes\.jsonl|reactions\.csv|path\.csv|open_in_paraview\.py"
     r"|(deformed|surface)(_\d{4,}(_\d+)?\.(vtu|pvtu)|\.pvd|\.xdmf|\.h5)"
+    r"|reactions(_\d{4,}\.vtu|\.pvd)"
     r"|undeformed\.vtu|deformed\.png|mode_\d+\.png|animation\.gif"
     r"|checkpoint_\d+ranks_\d+\.npz|\.checkpoint_\d+ranks_\d+\.\d+\.tmp\.npz|\.tmp-.*\.json)"
 )
 
 #: the frame files among them (:mod:`beamfx.io.series`), overwritten in place by a new run
-FRAME_FILES = re.compile(r"(deformed|surface)_\d{4,}(_\d+)?\.(vtu|pvtu)")
+FRAME_FILES = re.compile(r"(deformed|surface)_\d{4,}(_\d+)?\.(vtu|pvtu)|reactions_\d{4,}\.vtu")
 
 
 class FolderError(OSError):

@@ -14,6 +14,11 @@ Formats:
   position, point arrays ``fields``, cell arrays ``cell`` (input index) and ``beam``;
 * ``surface`` (default): ``surface.pvd``, the real section swept along the deformed centre
   line (:mod:`beamfx.io.surface`), for beams whose section has a shape;
+* ``reactions`` (default): ``reactions.pvd``, one vertex per support (and spring to ground)
+  at its current position with point arrays ``force`` and ``moment`` (global axes, the moment
+  about the point), at the frames of the other series that have reactions (static, linear
+  static, arc length; a transient's output steps, not its initial state); written by rank 0
+  alone (the reactions are reduced already); none for a scene without supports;
 * ``xdmf``: ``deformed.xdmf`` + ``.h5`` through DOLFINx (:mod:`beamfx.io.xdmf`): not a default,
   since DOLFINx rewrites its XML at every frame (the cost grows with the frames).
 
@@ -28,8 +33,8 @@ import numpy as np
 from ..settings import option
 from .fields import POINT_ARRAYS
 
-FORMATS = ("vtu", "surface", "xdmf")
-VTK_FORMATS = ("vtu", "surface")
+FORMATS = ("vtu", "surface", "reactions", "xdmf")
+VTK_FORMATS = ("vtu", "surface", "reactions")
 TRANSIENT_FRAMES = 200  # frames of a transient run when ``every`` is not given
 SCRIPT = "open_in_paraview.py"
 
@@ -56,8 +61,9 @@ class OutputSettings:
     formats: tuple[str, ...] = option(
         VTK_FORMATS,
         choices=FORMATS,
-        doc="files written: `vtu` (centre line), `surface` (swept section), `xdmf` "
-        "(HDF5; its cost grows with the frames)",
+        doc="files written: `vtu` (centre line), `surface` (swept section), `reactions` "
+        "(the supports' forces and moments, where there are supports), `xdmf` (HDF5; its "
+        "cost grows with the frames)",
     )
 
     def problems(self):
@@ -153,12 +159,23 @@ class FrameWriter:
                 self.series["deformed"] = VtkSeries(self.folder, "deformed", self.comm)
             if "surface" in settings.formats and any(v is not None for v in self.outlines.values()):
                 self.series["surface"] = VtkSeries(self.folder, "surface", self.comm)
-            self.grids = {name: GridBuffer() for name in self.series}
+            self.grids = {name: GridBuffer() for name in (*self.series, "reactions")}
         if "xdmf" in settings.formats:
             from .xdmf import XdmfSeries
 
             path = os.path.join(self.folder, "deformed.xdmf")
             self.xdmf = XdmfSeries(path, model.degree, settings.fields, self.comm)
+        spec = getattr(model, "spec", None)
+        points = spec is not None and bool(spec.supports or spec.springs)
+        self.has_reactions = "reactions" in settings.formats and points
+        self.reactions = None  # rank 0: the series of the reactions
+        self.reaction_frames = 0  # frames of it written (counted on every rank)
+        if self.has_reactions and self.comm.rank == 0:
+            from mpi4py import MPI
+
+            from .series import VtkSeries
+
+            self.reactions = VtkSeries(self.folder, "reactions", MPI.COMM_SELF)
         if "deformed" in self.series:
             write_paraview_script(self.folder, self.comm)
         self.policy = FramePolicy(settings)
@@ -172,11 +189,20 @@ class FrameWriter:
         (the full model a condensed one fell back to); the series go on."""
         self.model = model
 
-    def write(self, step, time):
-        """Write the current state as frame ``step`` at ``time`` (each rank its own piece)."""
+    def write(self, step, time, reactions=None):
+        """Write the current state as frame ``step`` at ``time`` (each rank its own piece),
+        and ``reactions`` ({point: {force, moment, position}}, the same on every rank) if
+        given (rank 0)."""
         from .fields import local_fields
         from .vtkfiles import lagrange_line_grid
 
+        if self.has_reactions and reactions:
+            self.reaction_frames += 1
+            if self.reactions is not None:
+                from .reaction_files import reaction_grid
+
+                grid = reaction_grid(reactions, self.grids["reactions"])
+                self.reactions.write(step, time, grid)
         if not self.series and self.xdmf is None:  # formats = []: nothing to write
             self.policy.record(step, time)
             return
@@ -217,7 +243,7 @@ class FrameWriter:
     def resume(self, t_max):
         """Keep the frames up to ``t_max`` of an earlier run in the folder (a restart) and
         drop later ones with their files."""
-        for series in self.series.values():
+        for series in self._all_series():
             series.resume(t_max)
         if self.xdmf is not None:
             self.xdmf.resume(t_max)
@@ -225,10 +251,14 @@ class FrameWriter:
 
     def close(self):
         """Close the files that stay open (the series' indices, XDMF)."""
-        for series in self.series.values():
+        for series in self._all_series():
             series.close()
         if self.xdmf is not None:
             self.xdmf.close()
+
+    def _all_series(self):
+        """The VTK series this rank writes (the reactions' on rank 0 only)."""
+        return [*self.series.values(), *([self.reactions] if self.reactions else [])]
 
     def files(self):
         """The ``paraview`` entry of results.json: the series written and the script."""
@@ -239,6 +269,8 @@ class FrameWriter:
             out["xdmf"] = "deformed.xdmf"
         if "surface" in self.series:
             out["surface"] = "surface.pvd"
+        if self.reaction_frames:
+            out["reactions"] = "reactions.pvd"
         if "deformed" in self.series:
             out["script"] = SCRIPT
         return out

@@ -164,6 +164,9 @@ def test_paraview_reads_transient_modal_and_buckling(tmp_path, analysis, keys):
     frames = (
         results["time_steps"] // 2 + 1 if analysis == "transient" else {"modal": 4}.get(analysis, 2)
     )
+    reactions = files.pop("reactions.pvd", None)  # a transient's from its first step on
+    assert (reactions is None) == (analysis != "transient")
+    assert reactions is None or reactions["times"] == frames - 1
     assert {f["times"] for f in files.values() if "times" in f} == {frames}
     assert files["surface.pvd"]["points"] > files["deformed.pvd"]["points"]
     image = files["png"]
@@ -202,3 +205,36 @@ def test_paraview_reads_every_format(tmp_path):
     assert set(files) == {"deformed.pvd", "surface.pvd", "deformed.xdmf", "png"}
     assert {f["times"] for f in files.values() if "times" in f} == {steps}
     assert files["deformed.pvd"]["distance_to_tip"] < TOL_POSITION * L
+
+
+@pytest.mark.skipif(PVPYTHON is None, reason="pvpython not found (apt: python3-paraview)")
+@pytest.mark.skipif(
+    not os.environ.get("DISPLAY") and XVFB is None,
+    reason="no DISPLAY and no Xvfb (apt: xvfb) for ParaView's X-only rendering",
+)
+def test_paraview_reads_the_reactions_of_a_cantilever(tmp_path):
+    """The reactions series of a linear cantilever under a tip force F and moment M: ParaView
+    finds one vertex at the clamp with force −F and moment −(M + x_tip × F) (statically
+    determinate; the balance of a linear solve is at round-off, 1e-10 of the load scale), the
+    values results.json holds (the frames store the doubles: equal to 1e-12)."""
+    import numpy as np
+    from test_reactions import CANTILEVER
+
+    folder = Path(comm.bcast(str(tmp_path), root=0))
+    if comm.rank == 0:
+        text = CANTILEVER.replace("KIN", "linear").replace("CONDENSE", "none")
+        (folder / "scene.toml").write_text(text)
+    comm.barrier()
+    out = folder / "out"
+    results = run_scene(folder / "scene.toml", out_dir=out, log=lambda message: None)
+    report, error = _pvcheck(out)
+    assert error is None, error
+    assert report["ok"], report["failed"]
+    found = report["files"]["reactions.pvd"]
+    assert found["points"] == 1 and found["times"] == report["files"]["deformed.pvd"]["times"]
+    F, M = np.array([1e3, -2e3, 5e3]), np.array([100, 0, 300.0])
+    expected = {"force": -F, "moment": -(M + np.cross([2.0, 0, 0], F))}
+    for key, value in expected.items():
+        assert np.allclose(found[key][0], value, rtol=0, atol=1e-10 * 1e4)
+        assert np.allclose(found[key][0], results["reactions"]["b:start"][key], rtol=0, atol=1e-12)
+    assert np.allclose(found["positions"][0], [0, 0, 0], atol=1e-12)

@@ -341,7 +341,7 @@ def test_output_settings_problems():
     assert keys == ["times"]
     assert [k for k, _ in OutputSettings(times=(2.0, 1.0)).problems()] == ["times"]
     assert [k for k, _ in OutputSettings(formats=("vtu", "vtu")).problems()] == ["formats"]
-    assert OutputSettings().formats == ("vtu", "surface")  # XDMF is not a default
+    assert OutputSettings().formats == ("vtu", "surface", "reactions")  # XDMF is not a default
 
 
 def test_json_atomic_and_writable(tmp_path):

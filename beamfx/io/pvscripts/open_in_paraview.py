@@ -8,8 +8,9 @@ centre line, coloured by |u|, over the undeformed centre line in grey.
 
 Without a display (Debian's ParaView renders through X only) prefix ``xvfb-run -a``. Runs in
 ParaView's own Python: it imports nothing from beamfx. Reads ``deformed.pvd`` (the centre
-line, arrays X, u, e1..e3, N, M) and ``surface.pvd`` (the surface, arrays u, N, M) beside it,
-or in the folder given with ``--dir``.
+line, arrays X, u, e1..e3, N, M), ``surface.pvd`` (the surface, arrays u, N, M) and
+``reactions.pvd`` (the supports, drawn as red dots; arrays force, moment) where present, beside
+it or in the folder given with ``--dir``.
 """
 
 import argparse
@@ -107,6 +108,10 @@ def show_results(folder, view=None, time=None):
     bar.RangeLabelFormat = "%-#.3g"
     out["display"] = disp
 
+    reactions = show_reactions(folder, view)
+    if reactions is not None:
+        out["reactions"] = reactions
+
     name = os.path.basename(os.path.abspath(folder))
     label = pvs.Text(Text=f"{name}: {_time_label(folder, time)}")
     label_show = pvs.Show(label, view)
@@ -128,6 +133,22 @@ def show_results(folder, view=None, time=None):
     disp.RescaleTransferFunctionToDataRange(False, True)
     fit_camera(view)
     return out
+
+
+def show_reactions(folder, view):
+    """Show ``reactions.pvd`` of ``folder`` (the supports; arrays force, moment) as red dots;
+    its reader, or None if there is none."""
+    path = os.path.join(folder, "reactions.pvd")
+    if not os.path.exists(path):
+        return None
+    reactions = pvs.PVDReader(FileName=path)
+    dots = pvs.Show(reactions, view)
+    dots.SetRepresentationType("Points")
+    dots.ColorArrayName = ["POINTS", ""]
+    dots.AmbientColor = dots.DiffuseColor = (0.8, 0.1, 0.1)
+    dots.PointSize = 12.0
+    dots.RenderPointsAsSpheres = 1
+    return reactions
 
 
 def fit_camera(view, direction=VIEW_DIRECTION, up=VIEW_UP, zoom=0.95):

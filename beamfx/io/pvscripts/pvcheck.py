@@ -9,8 +9,11 @@ Opens ``deformed.pvd`` (``.vtu`` or, from several ranks, ``.pvtu`` frames of Lag
 and ``surface.pvd`` and ``deformed.xdmf`` where present, at the last time; checks the point
 arrays each must carry and that the deformed centre line has a point within ``tol`` of ``tip``
 (if given; the XDMF holds the reference line, so X + u there) and the surface one within
-``tol`` plus half the section's size; renders the picture of ``open_in_paraview.py`` to
-``--png``. Prints one JSON line with what it found; exit status 1 if a check failed.
+``tol`` plus half the section's size; reads ``reactions.pvd`` where present (a vertex per
+support, arrays ``force`` and ``moment``; its times those of the deformed series, a
+transient's without t = 0) and reports its last frame's values; renders the picture of
+``open_in_paraview.py`` to ``--png``. Prints one JSON line with what it found; exit status 1 if
+a check failed.
 """
 
 import argparse
@@ -31,6 +34,8 @@ REQUIRED = {
     "deformed.xdmf": ("X", "u", "e1", "e2", "e3", "N", "M"),
     "surface.pvd": ("u", "N", "M"),
 }
+REACTIONS = "reactions.pvd"
+REACTION_ARRAYS = ("force", "moment")
 
 
 def read(path):
@@ -98,7 +103,27 @@ def check(folder, tip=None, tol=0.5):
     n = {entry["times"] for entry in found.values()}
     if len(n) != 1:
         failed.append(f"the files hold different numbers of time steps: {n}")
+    if os.path.exists(os.path.join(folder, REACTIONS)):
+        found[REACTIONS] = check_reactions(folder, found["deformed.pvd"], failed)
     return found, failed
+
+
+def check_reactions(folder, deformed, failed):
+    """The reactions series: its arrays, its last time that of ``deformed`` (the entry of
+    deformed.pvd), and the values of its last frame (positions, force, moment per point)."""
+    points, arrays, times = read(os.path.join(folder, REACTIONS))
+    missing = [a for a in REACTION_ARRAYS if a not in arrays]
+    if missing:
+        failed.append(f"{REACTIONS}: missing arrays {missing}")
+    if times[-1] != deformed["last_time"] or len(times) not in (
+        deformed["times"],
+        deformed["times"] - 1,
+    ):
+        failed.append(f"{REACTIONS}: times {times} do not follow the deformed series'")
+    entry = {"points": len(points), "times": len(times), "last_time": times[-1]}
+    entry["positions"] = points.tolist()
+    entry.update({a: arrays[a].tolist() for a in REACTION_ARRAYS if a in arrays})
+    return entry
 
 
 def _section_radius(points, arrays):
