@@ -170,13 +170,15 @@ class CondensedModel(Discretised):
         )
         # the cells' vertex 0 -> 1 direction against increasing arc length (DOLFINx may
         # reverse a cell): t_s = ±t0 is the tangent d/ds, for the terms linear in it
-        s_ends = d.cell_arc_lengths([0.0, 1.0])
+        self._s_ends = s_ends = d.cell_arc_lengths([0.0, 1.0])  # geometry: kept for sync
         self._flipped = s_ends[:, 0] > s_ends[:, 1]
         self.t_s = d.cell_function(np.where(self._flipped, -1.0, 1.0)) * d.t0
         self.W = self._space(m, p)
         self.w = fem.Function(self.W, name=self.field_name)
         U = fem.FunctionSpace(m, ufl.VectorElement("Lagrange", m.ufl_cell(), p, dim=3))
         self.u = fem.Function(U, name="displacement")  # derived: :meth:`sync`
+        # the node order of a cell of U, as reference coordinates (for sync)
+        self._xi = np.asarray(U.element.interpolation_points()).reshape(-1)
         self.dx = ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p + 2})
         self._build_forms()
         verts = self.mesh.point_tags.find(self.mesh.points[model.supports[0].at][0])
@@ -380,14 +382,12 @@ class CondensedModel(Discretised):
         if self._in_sync():
             return
         stamp = (float(self.load_factor.value), self.w.x.array.copy())
-        V, m = self.u.function_space, self.mesh.mesh
-        xi = np.asarray(V.element.interpolation_points()).reshape(-1)  # node order of a cell
+        V, m, xi = self.u.function_space, self.mesh.mesh, self._xi
         if self.coupling:  # follower forces from the converged rotations
             self.coupling.update()
         inc = self._increments(xi)
         n = m.topology.index_map(1).size_local
-        s_ends = self.discretisation.cell_arc_lengths([0.0, 1.0])
-        s_a = s_ends[:n].min(axis=1)
+        s_a = self._s_ends[:n].min(axis=1)
         flipped = self._flipped[:n]
         one = int(np.argmin(np.abs(xi - 1.0)))  # the node at vertex 1
         step = np.where(flipped[:, None], -inc[:, one], inc[:, one])  # from s_a to s_b
