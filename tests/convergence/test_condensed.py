@@ -142,3 +142,31 @@ def test_rotations_near_two_pi_stop_with_a_clear_error():
     model = CondensedModel(spec, extra_points=["b:end"])
     with pytest.raises(RotationRangeError, match='condense = "none"'):
         solve_static(model, steps=10)
+
+
+def test_sync_integrates_once_per_state_and_again_when_it_changes():
+    """Probes, reactions and frames each ask the condensed model for its displacement after a
+    step: integrated once per (w, load factor), redone when either changes."""
+    from beamfx.bench._builders import cantilever, straight
+    from beamfx.physics import sections
+
+    sec = sections.rectangle(1.0, 0.5, 1.0, 1.0, 1.0, nu=0.0)
+    spec = cantilever(straight(1.0), sec, 4, 2, moment=(0, 0.5 * np.pi * sec.EI_y, 0))
+    model = CondensedModel(spec, extra_points=["b:end"])
+    solve_static(model, steps=2)
+    model.sync()
+    u = model.u.x.array.copy()
+    model.u.x.array[:] = 0.0  # a second call with the same state leaves u alone
+    model.sync()
+    assert not model.u.x.array.any()
+    model.w.x.array[:] *= 0.5  # another state: integrated anew
+    model.sync()
+    half = model.u.x.array.copy()
+    assert np.abs(half - u).max() > 0.01
+    model.w.x.array[:] *= 2.0
+    model.sync()
+    assert np.allclose(model.u.x.array, u, rtol=0, atol=1e-14)
+    model.reset()
+    assert not model.u.x.array.any()
+    model.sync()  # the undeformed state after a reset: integrated, zero
+    assert np.abs(model.u.x.array).max() < 1e-14
