@@ -118,50 +118,21 @@ def trace_path(
     """
     t0 = time.perf_counter()
     _check_model(model)
-    spec = model.spec
-    if control_point is None:
-        if not spec.point_loads:
-            raise ValueError("no point load: name a control_point")
-        control_point = spec.point_loads[0].at
+    control_point, comp, limit = _control(model.spec, control_point, displacement_limit)
     dofs = point_displacement_dofs(model, control_point)
-    if displacement_limit is not None:
-        comp, limit = displacement_limit
-        if comp not in DOF_NAMES[:3]:
-            raise ValueError(
-                f"displacement_limit component must be one of {DOF_NAMES[:3]}, got {comp!r}"
-            )
-        comp = DOF_NAMES.index(comp)
-
     u_dofs = subspace_dofs(model.W, 0)
     settings = _model_settings(model, settings or ArcLengthSettings(), u_dofs)
     c0 = compile_seconds[0]
     solver = ArcLengthSolver(
-        model.F,
-        model.J,
-        model.w,
-        model.load_factor,
-        model.bcs,
-        prefix,
-        options,
-        settings,
+        *(model.F, model.J, model.w, model.load_factor, model.bcs, prefix, options, settings),
         norm_dofs=u_dofs,
         sizes=state_sizes(model),
     )
     compile_time = compile_seconds[0] - c0
-
-    path = [PathPoint(float(model.load_factor.value), point_displacement(model, dofs), 0, 0.0)]
-
-    def record(step):
-        s = path[-1].arc_length + step.arc_length
-        u = point_displacement(model, dofs)
-        path.append(
-            PathPoint(step.load_factor, u, step.iterations, s, step.negative_eigenvalues, step.note)
-        )
-        if on_step:
-            on_step(path[-1])
+    path, record = _recorder(model, dofs, on_step)
 
     def stop_here(step):
-        if displacement_limit is not None and abs(path[-1].displacement[comp]) >= abs(limit):
+        if comp is not None and abs(path[-1].displacement[comp]) >= abs(limit):
             return True
         return bool(stop is not None and stop(path))
 
@@ -177,6 +148,40 @@ def trace_path(
     return ContinuationResult(
         tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
     )
+
+
+def _control(spec, control_point, displacement_limit):
+    """(control point, index of the limited component or None, the limit): the first point
+    load's point by default."""
+    if control_point is None:
+        if not spec.point_loads:
+            raise ValueError("no point load: name a control_point")
+        control_point = spec.point_loads[0].at
+    if displacement_limit is None:
+        return control_point, None, None
+    comp, limit = displacement_limit
+    if comp not in DOF_NAMES[:3]:
+        raise ValueError(
+            f"displacement_limit component must be one of {DOF_NAMES[:3]}, got {comp!r}"
+        )
+    return control_point, DOF_NAMES.index(comp), limit
+
+
+def _recorder(model, dofs, on_step):
+    """(the path so far, starting at the current state; ``record(step)`` appending a step's
+    :class:`PathPoint` and calling ``on_step`` with it)."""
+    path = [PathPoint(float(model.load_factor.value), point_displacement(model, dofs), 0, 0.0)]
+
+    def record(step):
+        s = path[-1].arc_length + step.arc_length
+        u = point_displacement(model, dofs)
+        path.append(
+            PathPoint(step.load_factor, u, step.iterations, s, step.negative_eigenvalues, step.note)
+        )
+        if on_step:
+            on_step(path[-1])
+
+    return path, record
 
 
 def _model_settings(model, settings, u_dofs):
