@@ -234,18 +234,20 @@ class Discretisation:
     dx: object  #: measure of everything else (degree 2p)
     matrices: object = None  #: :class:`SectionMatrices`, or None: every section is diagonal
 
-    def strain_energy(self, Gamma, K, scale=None):
+    def strain_energy(self, Gamma, K, scale=None, dx=None):
         """The strain energy of the sections (times ``scale``, e.g. a damping time, if given):
         :func:`~beamfx.physics.energy.strain_energy` with C_N, C_M for diagonal sections, the
-        coupled form :func:`~beamfx.physics.coupled.strain_energy` with a matrix section."""
+        coupled form :func:`~beamfx.physics.coupled.strain_energy` with a matrix section.
+        ``dx``: one measure for both parts (else ``dx_shear`` and ``dx``)."""
+        dx_shear, dx_bend = (self.dx_shear, self.dx) if dx is None else (dx, dx)
         if self.matrices is None:
             if scale is None:
-                return energy.strain_energy(Gamma, K, self.C_N, self.C_M, self.dx_shear, self.dx)
+                return energy.strain_energy(Gamma, K, self.C_N, self.C_M, dx_shear, dx_bend)
             return energy.strain_rate_dissipation(
-                Gamma, K, self.C_N, self.C_M, scale, self.dx_shear, self.dx
+                Gamma, K, self.C_N, self.C_M, scale, dx_shear, dx_bend
             )
         C = self.matrices.C if scale is None else scale * self.matrices.C
-        return coupled.strain_energy(Gamma, K, C, self.dx_shear, self.dx)
+        return coupled.strain_energy(Gamma, K, C, dx_shear, dx_bend)
 
     def resultants(self, Gamma, K):
         """Section force and moment (N, M) of the strains (Γ, K), section axes."""

@@ -26,7 +26,7 @@ import ufl
 
 from ..physics import coupled
 from ..physics.inertia import angular_velocity, point_kinetic_energy
-from ..physics.kinematics import displacement, strains
+from ..physics.kinematics import displacement
 from ..solvers import NewtonSolver
 from ..solvers.integrators import AlphaStep, generalized_alpha, hht, newmark
 from ..solvers.snes import SolveFailed
@@ -36,6 +36,7 @@ from .conserving import Projection
 from .dofs import constrained_dofs, owned_size, subspace_dofs
 from .extrapolation import Extrapolation
 from .section_fields import section_kinetic_energy
+from .strain_rates import StrainHistory, bdf2_weights
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
 
@@ -154,17 +155,18 @@ class Dynamics:
         if settings.damping_mass:
             inertia += a0 * p
             power += a0 * 2 * T
-        if settings.damping_stiffness:
-            u, rot = ufl.split(w)
-            Gamma, K = strains(kin, u, rot, d.t0, d.Lam0)
-            rate = [ufl.derivative(x, w, V) for x in (Gamma, K)]
-            D = d.strain_energy(*rate, scale=a1)
-            inertia += ufl.derivative(D, V, test)
-            power += 2 * D
         v_expr, qdd_expr = self.scheme.rates(w, self.q_n, self.v_n, self.a_n, self.qdd_n)
         # the inertia (and damping) forces of the step: their resultant is the rate of the
         # momenta at t_{n+1} (transient_reactions.py)
         self.inertia_forces = ufl.replace(inertia, {V: v_expr, A: qdd_expr})
+        self.strain_history = None
+        if settings.damping_stiffness:  # viscous stresses a1 C ε̇ on objective rates
+            sh = self.strain_history = StrainHistory(model, self.h)
+            c0 = bdf2_weights(self.h, sh.h_prev, sh.second)[0]  # ∂ε̇/∂ε_{n+1}
+            D = d.strain_energy(*sh.rate(w), scale=a1 / c0, dx=sh.dx)
+            self.inertia_forces += ufl.derivative(D, w, test)  # a1 C ε̇ · δε
+            stored = self.strain_history.stored_rate()
+            power += 2 * d.strain_energy(*stored, scale=a1, dx=self.strain_history.dx)
         self.F = model.F + self.inertia_forces
         self.J = ufl.derivative(self.F, w, ufl.TrialFunction(W))
         # energies at the state (w, v_n): evaluated after v_n holds the new velocity
@@ -213,6 +215,8 @@ class Dynamics:
         self.q_n.x.array[:] = self.model.w.x.array
         for f in (self.v_n, self.a_n, self.qdd_n):
             f.x.array[:] = 0.0
+        if self.strain_history:
+            self.strain_history.start()
 
     def predict(self, h):
         """Newton's starting point: the step with unchanged acceleration, and the prescribed
@@ -229,6 +233,8 @@ class Dynamics:
         arrays = [f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n)]
         v, a, qdd = self.scheme.advance(self.model.w.x.array, *arrays, h)
         self.v_n.x.array[:], self.a_n.x.array[:], self.qdd_n.x.array[:] = v, a, qdd
+        if self.strain_history:
+            self.strain_history.accept(h)
         self.q_n.x.array[:] = self.model.w.x.array
         if self.project_rates:
             self._tangent_rates()
@@ -268,13 +274,16 @@ class Dynamics:
 
     def state(self):
         """Copies of the time-stepping state (q, v, a, q̈ at t_n), for a checkpoint."""
-        return {k: getattr(self, k).x.array.copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
+        arrays = {k: getattr(self, k).x.array.copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
+        return arrays | (self.strain_history.state() if self.strain_history else {})
 
     def set_state(self, arrays):
         """Restore the time-stepping state saved by :meth:`state`; the model's unknowns follow q."""
-        for k, a in arrays.items():
-            getattr(self, k).x.array[:] = a
+        for k in ("q_n", "v_n", "a_n", "qdd_n"):
+            getattr(self, k).x.array[:] = arrays[k]
         self.model.w.x.array[:] = self.q_n.x.array
+        if self.strain_history:
+            self.strain_history.set_state(arrays)
 
 
 class EnergyBalance:
@@ -427,7 +436,7 @@ def restore_state(saved, dyn, balance, control):
     """Put a checkpoint's (header, arrays) back: state, energy balance and step controller;
     returns (t, step)."""
     header, arrays = saved
-    dyn.set_state({k: arrays[k] for k in ("q_n", "v_n", "a_n", "qdd_n")})
+    dyn.set_state(arrays)
     if dyn.extrapolation:
         dyn.extrapolation.restore(arrays)
     b = header["balance"]
