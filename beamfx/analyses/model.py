@@ -72,6 +72,7 @@ class BeamModel(Discretised):
 
         self.load_factor = fem.Constant(m, PETSc.ScalarType(0.0))
         self.time, self._load_histories = 0.0, []
+        self.penalty_motion = []  # (∂Π/∂f form, f(t) constant) of local supports
         self._build_forms()
         self.bcs, self._bc_values = self._build_supports()
         if model.releases:
@@ -150,18 +151,23 @@ class BeamModel(Discretised):
 
     def _history_factor(self, load):
         """1, or a constant that :meth:`set_time` sets to the load's history f(t)."""
+        return self._time_factor(load.history)
+
+    def _time_factor(self, history):
+        """1 if ``history`` is None, else a constant that :meth:`set_time` sets to f(t)."""
         from dolfinx import fem
         from petsc4py import PETSc
 
-        if load.history is None:
+        if history is None:
             return 1.0
-        c = fem.Constant(self.mesh.mesh, PETSc.ScalarType(load.history(0.0)))
-        self._load_histories.append((c, load.history))
+        c = fem.Constant(self.mesh.mesh, PETSc.ScalarType(history(0.0)))
+        self._load_histories.append((c, history))
         return c
 
     def _local_support_penalty(self, sup, u3, rot):
         """Stiff springs on the fixed dofs in the section axes Λ0 at the point (values scaled by
-        the load factor). Stiffness 1e9·(largest EA, GA or GJ, EI)/(shortest element)."""
+        the load factor and, in a transient, by the support's history of each part, as the
+        global supports are). Stiffness 1e9·(largest EA, GA or GJ, EI)/(shortest element)."""
         disc = self.discretisation
         h = disc.min_cell_length()
         C = disc.stiffness
@@ -169,14 +175,19 @@ class BeamModel(Discretised):
         k_r = 1e9 * ufl.max_value(ufl.max_value(C[3], C[4]), C[5]) / h
         local_u = disc.Lam0.T * u3
         local_r = disc.Lam0.T * rotation_vector(self.kin, rot)
-        terms = 0
+        factors = [self._time_factor(sup.history_of(part)) for part in (0, 1)]
+        terms, slopes = 0, [0, 0]  # slopes: ∂Π/∂f of each part (the work of a moving support)
         for d in sup.fix:
             i = DOF_NAMES.index(d)
-            if i < 3:
-                value, target, k = local_u[i], self.load_factor * sup.displacement[i], k_u
-            else:
-                value, target, k = local_r[i - 3], self.load_factor * sup.rotation[i - 3], k_r
+            part = int(i >= 3)
+            value = (local_u if i < 3 else local_r)[i % 3]
+            unit = self.load_factor * (sup.displacement if i < 3 else sup.rotation)[i % 3]
+            target, k = factors[part] * unit, (k_u, k_r)[part]
             terms += energy.constraint_penalty([value], [target], k)
+            slopes[part] += -k * (value - target) * unit
+        for f, slope in zip(factors, slopes):
+            if not isinstance(f, float) and not isinstance(slope, int):
+                self.penalty_motion.append((self.discretisation.at_point(sup.at, slope), f))
         return terms
 
     def _build_supports(self):

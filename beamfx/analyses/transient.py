@@ -311,6 +311,9 @@ class EnergyBalance:
         self.momenta = [compile_form(f) for f in dyn.momenta]
         self.residual = residual
         self.moving = any(s.timed for s in m.spec.supports)
+        # supports in local axes: penalties whose target moves with f(t); their work is
+        # ∫ ∂Π/∂f df (trapezoidal), the rest of the support work is reaction · Δq
+        self.penalty_motion = [(compile_form(g), c) for g, c in m.penalty_motion]
         self.vec = fp.create_vector(self.residual)
         self.n_owned = owned_size(m.W)
         mask = np.zeros(len(m.w.x.array), bool)
@@ -355,6 +358,7 @@ class EnergyBalance:
             "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
             "reaction": self.reaction,
             "power": self.scalar(self.P) if self.P is not None else 0.0,
+            "penalty": [[self.scalar(g), float(c.value)] for g, c in self.penalty_motion],
         }
         if self.previous is not None:
             dq = q - q_old[owned]
@@ -367,6 +371,8 @@ class EnergyBalance:
                 self.values["work_loads"] += trapezoid("loads")
             if self.moving:
                 self.values["work_supports"] += trapezoid("reaction")
+            for (g0, f0), (g1, f1) in zip(prev.get("penalty") or [], now["penalty"]):
+                self.values["work_supports"] += 0.5 * (g0 + g1) * (f1 - f0)
             self.values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
         self.previous = now
         out = {"kinetic": self.scalar(self.T), "strain": self.scalar(self.Pi), **self.values}
@@ -423,6 +429,7 @@ def checkpoint_state(dyn, balance, control, t, step):
     previous = balance.previous or {}
     saved = {"values": dict(balance.values), "initial": balance.initial}
     saved["power"] = previous.get("power")
+    saved["penalty"] = previous.get("penalty")
     for key in ("loads", "reaction"):
         value = previous.get(key)
         if isinstance(value, np.ndarray):
@@ -442,7 +449,7 @@ def restore_state(saved, dyn, balance, control):
     b = header["balance"]
     previous = None
     if b["power"] is not None:
-        previous = {"power": b["power"]}
+        previous = {"power": b["power"], "penalty": b.get("penalty")}
         for key in ("loads", "reaction"):
             value = b.get(key)
             previous[key] = arrays[f"balance_{key}"] if value == "array" else (value or 0.0)
