@@ -33,9 +33,11 @@ FIELDS = ("strain_n", "strain_nm1", "strain_rate_n")
 
 
 def strain_vector(model, w):
-    """(Γ, K) of the unknowns ``w`` as one 6-vector (section axes)."""
+    """(Γ, K) of the unknowns ``w`` (the model's, or a function of its space) as one 6-vector
+    (section axes); the members' rotation (with released ends) as the strain energy has it."""
     d = model.discretisation
-    u, rot = ufl.split(w)
+    u = ufl.split(w)[0]
+    rot = ufl.replace(model._member_rotation(), {model.w: w})
     Gamma, K = strains(model.kin, u, rot, d.t0, d.Lam0)
     return ufl.as_vector([Gamma[i] for i in range(3)] + [K[i] for i in range(3)])
 
