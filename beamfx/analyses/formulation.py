@@ -95,6 +95,12 @@ class BeamFormulation(Formulation, Protocol):
     k_penalty: object
     """``fem.Constant`` of the quaternion unit-norm penalty (part of ``Pi`` for finite
     spatial kinematics)."""
+    strains: tuple
+    """UFL (Γ, K) of ``w``, section axes (with the members' rotation at released ends), as in
+    the strain energy."""
+    penalty_motion: list
+    """(UFL ∂Π/∂f, its ``fem.Constant`` f(t)) of each part of a support in local axes that a
+    history moves: the support's work is ∫ ∂Π/∂f df."""
 
     def set_time(self, t: float) -> None:
         """Time of a transient: loads and supports with a history take their values at t."""

@@ -88,6 +88,7 @@ class BeamModel(Discretised):
         test = ufl.TestFunction(self.W)
         v_u, v_rot = ufl.split(test)[:2]
         Gamma, K = strains(kin, u, self._member_rotation(), d.t0, d.Lam0)
+        self.strains = (Gamma, K)
         Pi = d.strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, d.dx)

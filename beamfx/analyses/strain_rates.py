@@ -26,19 +26,13 @@ elements too); the damping forms use that measure for both parts.
 import numpy as np
 import ufl
 
-from ..physics.kinematics import strains
-
 #: names of the stored fields (state of a checkpoint); ``strain_steps``: (h_prev, 1 if ε_{n−1})
 FIELDS = ("strain_n", "strain_nm1", "strain_rate_n")
 
 
-def strain_vector(model, w):
-    """(Γ, K) of the unknowns ``w`` (the model's, or a function of its space) as one 6-vector
-    (section axes); the members' rotation (with released ends) as the strain energy has it."""
-    d = model.discretisation
-    u = ufl.split(w)[0]
-    rot = ufl.replace(model._member_rotation(), {model.w: w})
-    Gamma, K = strains(model.kin, u, rot, d.t0, d.Lam0)
+def strain_vector(model):
+    """(Γ, K) of the model's unknowns as one 6-vector (section axes)."""
+    Gamma, K = model.strains
     return ufl.as_vector([Gamma[i] for i in range(3)] + [K[i] for i in range(3)])
 
 
@@ -74,15 +68,15 @@ class StrainHistory:
         self.h_prev = fem.Constant(mesh, PETSc.ScalarType(1.0))
         self.second = fem.Constant(mesh, PETSc.ScalarType(0.0))
         points = _quadrature_points(degree)
-        self._strain = fem.Expression(strain_vector(model, model.w), points)
+        self._strain = fem.Expression(strain_vector(model), points)
         self._index = _dof_index(self.Q, len(points))
         self.dx = d.dx_shear
 
-    def rate(self, w):
-        """ε̇_{n+1} as a UFL expression of the unknowns q_{n+1} = ``w``, as (Γ̇, K̇)."""
+    def rate(self):
+        """ε̇_{n+1} as a UFL expression of the model's unknowns q_{n+1}, as (Γ̇, K̇)."""
         f = self.fields
         c0, c1, c2 = bdf2_weights(self.h, self.h_prev, self.second)
-        return _split(c0 * strain_vector(self.model, w) + c1 * f["strain_n"] + c2 * f["strain_nm1"])
+        return _split(c0 * strain_vector(self.model) + c1 * f["strain_n"] + c2 * f["strain_nm1"])
 
     def stored_rate(self):
         """ε̇_n (after :meth:`accept`: at the new time), as (Γ̇, K̇)."""

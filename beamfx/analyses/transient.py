@@ -163,7 +163,7 @@ class Dynamics:
         if settings.damping_stiffness:  # viscous stresses a1 C ε̇ on objective rates
             sh = self.strain_history = StrainHistory(model, self.h)
             c0 = bdf2_weights(self.h, sh.h_prev, sh.second)[0]  # ∂ε̇/∂ε_{n+1}
-            D = d.strain_energy(*sh.rate(w), scale=a1 / c0, dx=sh.dx)
+            D = d.strain_energy(*sh.rate(), scale=a1 / c0, dx=sh.dx)
             self.inertia_forces += ufl.derivative(D, w, test)  # a1 C ε̇ · δε
             stored = self.strain_history.stored_rate()
             power += 2 * d.strain_energy(*stored, scale=a1, dx=self.strain_history.dx)
