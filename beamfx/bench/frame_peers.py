@@ -275,14 +275,19 @@ NOTE = (
 )
 
 
-def main(argv):
-    """``export DIR`` or ``DIR [REPORT_DIR]``."""
+def cli(argv, export, compare, module):
+    """A peer comparison's command line: ``export DIR`` or ``DIR [REPORT_DIR]``."""
     if len(argv) == 2 and argv[0] == "export":
         export(argv[1])
     elif len(argv) in (1, 2) and argv[0] != "export":
         compare(*argv)
     else:
-        raise SystemExit("usage: python -m beamfx.bench.frame_peers export DIR | DIR [REPORT_DIR]")
+        raise SystemExit(f"usage: python -m {module} export DIR | DIR [REPORT_DIR]")
+
+
+def main(argv):
+    """``export DIR`` or ``DIR [REPORT_DIR]``."""
+    cli(argv, export, compare, "beamfx.bench.frame_peers")
 
 
 if __name__ == "__main__":

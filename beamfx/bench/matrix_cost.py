@@ -56,26 +56,16 @@ def iteration_seconds(model, budget=0.2, repeats=5):
     the residual and the tangent (supports applied), and the linear solve (MUMPS LU
     factorisation and solve, the static solver's default) as a whole iteration's time less
     the assembly's; CPU seconds (:func:`cpu_seconds`)."""
-    import dolfinx.fem.petsc as fp
     from petsc4py import PETSc
 
-    from ..solvers.forms import compile_form
+    from ..solvers.assembly import assembler
 
-    F, J = compile_form(model.F), compile_form(model.J)
-    b, A = fp.create_vector(F), fp.create_matrix(J)
+    b, A, assemble = assembler(model.F, model.J, model.bcs)
     ksp = PETSc.KSP().create(model.comm)
     ksp.setType("preonly")
     ksp.getPC().setType("lu")
     ksp.getPC().setFactorSolverType("mumps")
     x = b.duplicate()
-
-    def assemble():
-        with b.localForm() as local:
-            local.set(0.0)
-        fp.assemble_vector(b, F)
-        A.zeroEntries()
-        fp.assemble_matrix(A, J, bcs=model.bcs)
-        A.assemble()
 
     def iteration():
         assemble()

@@ -74,11 +74,8 @@ def stack_limits(model, settings=None):
     included) is then measured instead of the static one."""
     if model.comm.size > 1:
         return {}
-    import dolfinx.fem.petsc as fp
     import scipy.linalg
     from scipy.sparse import csr_matrix
-
-    from ..solvers.forms import compile_form
 
     F, J = model.F, model.J
     if settings is not None:
@@ -86,17 +83,9 @@ def stack_limits(model, settings=None):
 
         dyn = Dynamics(model, settings)
         F, J = dyn.F, dyn.J
-    F, J = compile_form(F), compile_form(J)
-    b, A = fp.create_vector(F), fp.create_matrix(J)
+    from ..solvers.assembly import assembler
 
-    def assemble():
-        with b.localForm() as local:
-            local.set(0.0)
-        fp.assemble_vector(b, F)
-        A.zeroEntries()
-        fp.assemble_matrix(A, J, bcs=model.bcs)
-        A.assemble()
-
+    b, A, assemble = assembler(F, J, model.bcs)
     try:
         assembly = _best_seconds(assemble)
         K = csr_matrix(A.getValuesCSR()[::-1], shape=A.getSize()).toarray()

@@ -265,14 +265,9 @@ def compare(out_dir, report_dir=None):
 
 def main(argv):
     """``export DIR`` or ``DIR [REPORT_DIR]``."""
-    if len(argv) == 2 and argv[0] == "export":
-        export(argv[1])
-    elif len(argv) in (1, 2) and argv[0] != "export":
-        compare(*argv)
-    else:
-        raise SystemExit(
-            "usage: python -m beamfx.bench.star_dome_peers export DIR | DIR [REPORT_DIR]"
-        )
+    from .frame_peers import cli
+
+    cli(argv, export, compare, "beamfx.bench.star_dome_peers")
 
 
 if __name__ == "__main__":

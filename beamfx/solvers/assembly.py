@@ -104,3 +104,24 @@ def assemble_load(f, F, load_factor, bcs):
     at_one.destroy()
     fp.set_bc(f, bcs, scale=0.0)
     load_factor.value = lam
+
+
+def assembler(F, J, bcs):
+    """(residual vector, tangent matrix, ``assemble()`` filling both) of the UFL forms F and J
+    with the supports ``bcs`` applied to the tangent: the assembly of one Newton iteration."""
+    import dolfinx.fem.petsc as fp
+
+    from ..solvers.forms import compile_form
+
+    F, J = compile_form(F), compile_form(J)
+    b, A = fp.create_vector(F), fp.create_matrix(J)
+
+    def assemble():
+        with b.localForm() as local:
+            local.set(0.0)
+        fp.assemble_vector(b, F)
+        A.zeroEntries()
+        fp.assemble_matrix(A, J, bcs=bcs)
+        A.assemble()
+
+    return b, A, assemble
