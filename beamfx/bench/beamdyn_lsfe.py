@@ -113,6 +113,7 @@ def elastica(beam=BEAM, tol=1e-10):
 
     s = np.linspace(0.0, L, 2001)
     guess = np.vstack([1.5 * s / L, 0 * s, 0 * s, s])
+
     def bc(root, tip):  # clamped root (θ, x, z), free tip (M)
         return np.array([root[0], tip[1], root[2], root[3]])
 
