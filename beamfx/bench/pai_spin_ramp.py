@@ -22,6 +22,7 @@ from itertools import pairwise
 
 import numpy as np
 
+from ..physics.rotations import np_exp_rotation as rotation_matrices
 from .registry import register
 from .scenes import SceneCase
 
@@ -114,19 +115,6 @@ def to_rotating(t, xyz):
     c, s = np.cos(psi), np.sin(psi)
     x, y, z = np.asarray(xyz, float).T
     return np.column_stack([c * x + s * y, -s * x + c * y, z])
-
-
-def rotation_matrices(vectors):
-    """Rodrigues: rotation matrices (n, 3, 3) of rotation vectors (n, 3)."""
-    v = np.asarray(vectors, float)
-    angle = np.linalg.norm(v, axis=1)
-    safe = np.where(angle > 0, angle, 1.0)
-    k = v / safe[:, None]
-    K = np.zeros((len(v), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
-    K -= np.transpose(K, (0, 2, 1))
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * K + (1 - c) * (K @ K)
 
 
 def tip_twist(vectors):
