@@ -112,7 +112,7 @@ def _peak_mib(comm, reset=False):
 
 def _solve(scene, comm):
     """Model, Newton solver and the static solve of ``scene``; (model, solver, seconds)."""
-    from ..analyses.condensed import build_model
+    from ..analyses.planar_condensed import build_model
     from ..analyses.static import solve_static
     from ..solvers import NewtonSolver
 
