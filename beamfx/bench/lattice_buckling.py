@@ -84,11 +84,10 @@ def scene_data(elements=None, degree=None, analysis=None):
 def run(data, folder):
     """``beamfx run`` of the scene data (its mesh read from demos/scenes/): the
     :class:`~beamfx.runner.RunResult`."""
-    from ..runner import run_scene
     from ..scene.load import parse_scene
+    from .scenes import run_in_process
 
-    scene = parse_scene(data, str(SCENE), DEMOS)
-    return run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)
+    return run_in_process(parse_scene(data, str(SCENE), DEMOS), folder)[0]
 
 
 def corner_posts():

@@ -33,17 +33,15 @@ def scene(up, elements=8, degree=3, speeds_hz=None, modes=2):
 
 def run(up):
     """(tips per scene speed {Hz: (y, z)}, f1 crossing in Hz) of one direction."""
-    from ..runner import run_scene
+    from .scenes import run_in_process
 
     with tempfile.TemporaryDirectory() as folder:
-        base = scene(up)
-        settled = run_scene(base.file, folder, log=lambda *a, **k: None, scene=base).result
+        settled = run_in_process(scene(up), folder)[0].result
         tips = {
             round(s["speed_rad_s"] / (2 * math.pi)): tuple(s["probes"]["tip"]["position"][1:])
             for s in settled.path
         }
-        sweep = scene(up, speeds_hz=sweep_hz())
-        result = run_scene(sweep.file, folder, log=lambda *a, **k: None, scene=sweep).result
+        result = run_in_process(scene(up, speeds_hz=sweep_hz()), folder)[0].result
     spin, _ = crossing(*lowest(result))
     return tips, spin
 

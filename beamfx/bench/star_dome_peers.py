@@ -19,7 +19,6 @@ and the slender I = 0.2377 cm⁴, whose apex snaps through locally first.
 import json
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -79,15 +78,13 @@ def export(out_dir):
 def beamfx_trace(elements, degree, folder, variant="star_dome"):
     """The arc-length trace by beamfx of one mesh through ``run_scene``: the first limit
     point, every extremum of the load, the path (load factor, apex uz), the run's wall time."""
-    from ..runner import run_scene
+    from .scenes import run_in_process
 
     data = star_dome.scene_data(elements, degree, variant)
     data["analysis"]["displacement_limit"] = ["uz", -LIMITS[variant]]
     data["analysis"]["arc_length"] = LIMITS[variant] / 30
     scene = star_dome.scene(data=data)
-    t0 = time.perf_counter()
-    run = run_scene(scene.file, folder, log=lambda *a, **k: None, scene=scene)
-    seconds = time.perf_counter() - t0
+    run, seconds = run_in_process(scene, folder)
     path = run.result.path
     extrema = [(p["kind"], p["load_factor"], p["displacement"][2]) for p in run.result.limit_points]
     return {
