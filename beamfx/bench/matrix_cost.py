@@ -14,7 +14,6 @@ variants alternated and the least of each kept. A whole run's per-iteration wall
 """
 
 import time
-import tomllib
 
 import numpy as np
 
@@ -22,16 +21,14 @@ import numpy as np
 def _cost_scene(section, elements, degree):
     """The coupled cantilever (beamfx/scenes/coupled_cantilever.toml) with ``section``, as a
     nonlinear static run of the full model (no planar or condensed trimming)."""
-    from importlib import resources
-
     from ..scene.load import parse_scene
+    from .coupled_cantilever import SCENE, _data
 
-    name = "coupled_cantilever.toml"
-    data = tomllib.loads(resources.files("beamfx.scenes").joinpath(name).read_text())
+    data = _data()
     data["beams"][0].update(elements=elements, degree=degree, section=section)
     data["analysis"] = {"type": "static", "steps": 1}
     data["model"] = {"condense": "none", "plane": "none"}
-    return parse_scene(data, name)
+    return parse_scene(data, SCENE)
 
 
 def _diagonal(stiffness):
