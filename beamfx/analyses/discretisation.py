@@ -115,13 +115,18 @@ def _twist_field(spec, mesh):
     cb, m = mesh.cell_beam, mesh.mesh
     if not any(callable(t) for t in twists):
         return cell_function(m, np.deg2rad([twists[b] for b in cb]))
-    q = mesh.degree
-    S = cell_arc_lengths(spec, mesh, dg_points(q))
+    return cell_field(m, mesh.degree, np.deg2rad(along_beams(spec, mesh, twists)))
+
+
+def along_beams(spec, mesh, per_beam):
+    """Values at the DG_p interpolation points of each local cell: ``per_beam[i]`` (a number,
+    or a vectorised function of the arc length s along beam i) on the cells of beam i."""
+    S = cell_arc_lengths(spec, mesh, dg_points(mesh.degree))
     values = np.zeros_like(S)
-    for i, t in enumerate(twists):
-        sel = cb == i
+    for i, t in enumerate(per_beam):
+        sel = mesh.cell_beam == i
         values[sel] = np.asarray(t(S[sel]), float) if callable(t) else t
-    return cell_field(m, q, np.deg2rad(values))
+    return values
 
 
 def _cell_tangents(mesh):
@@ -271,12 +276,9 @@ class Discretisation:
     def beam_profile(self, beam_index, f):
         """DG_p Function: f(s) at the interpolation points of the cells of one beam (s the arc
         length along it), 0 elsewhere."""
-        q = self.mesh.degree
-        S = self.cell_arc_lengths(dg_points(q))
-        values = np.zeros_like(S)
-        sel = self.mesh.cell_beam == beam_index
-        values[sel] = np.asarray(f(S[sel]), float)
-        return cell_field(self.mesh.mesh, q, values)
+        per_beam = [f if i == beam_index else 0.0 for i in range(len(self.spec.beams))]
+        values = along_beams(self.spec, self.mesh, per_beam)
+        return cell_field(self.mesh.mesh, self.mesh.degree, values)
 
     def min_cell_length(self):
         """Shortest cell, in arc length (all ranks). Collective."""
