@@ -22,6 +22,13 @@ from .table import Table, is_number
 FIX_WORDS = {"all": DOF_NAMES, "clamped": DOF_NAMES, "pinned": DOF_NAMES[:3]}
 
 
+def _constant(value):
+    """The vectorised function of one variable that is ``value`` everywhere (``text`` says it)."""
+    f = partial(np.full_like, fill_value=value, dtype=float)
+    f.text = str(value)
+    return f
+
+
 def _history(t, key="history"):
     """A function of time: a number, an expression of ``t`` or a table
     ``{ t = [...], values = [...] }`` (piecewise linear, constant beyond its ends); None if
@@ -34,9 +41,7 @@ def _history(t, key="history"):
         if isinstance(raw, bool):
             raise TypeError(f"{raw!r} is not a number")
         if isinstance(raw, (int, float)):
-            value = float(raw)
-            f = partial(np.full_like, fill_value=value, dtype=float)
-            f.text = str(value)
+            f = _constant(float(raw))
         elif isinstance(raw, str):
             f = compile_expression(raw, "t")
         elif isinstance(raw, dict):
@@ -180,11 +185,7 @@ def _profile(t, lengths):
     if beam not in lengths:
         t.fail("beam", f"{beam!r} is no beam; beams are {list(lengths)}")
     f = span_function(t, "profile", lengths[beam])
-    if not callable(f):
-        value = f
-        f = partial(np.full_like, fill_value=value, dtype=float)
-        f.text = str(value)
-    return f
+    return f if callable(f) else _constant(f)
 
 
 def read_loads(top, lengths):
