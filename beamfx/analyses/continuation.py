@@ -14,7 +14,7 @@ import numpy as np
 from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
 from ..spec import DOF_NAMES
-from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
+from .dofs import owned_size, point_displacement, point_displacement_dofs, subspace_dofs
 from .static import state_dependent_loads, state_sizes
 
 
@@ -213,8 +213,7 @@ def geometric_arc_length(model, u_dofs):
     reach, whatever the stiffness of its initial tangent (collective)."""
     from mpi4py import MPI
 
-    index_map = model.W.dofmap.index_map
-    owned = index_map.size_local * model.W.dofmap.index_map_bs
+    owned = owned_size(model.W)
     count = model.comm.allreduce(int(np.count_nonzero(np.asarray(u_dofs) < owned)), op=MPI.SUM)
     return GEOMETRIC_FRACTION * model_size(model) * float(np.sqrt(count))
 
