@@ -223,11 +223,10 @@ def is_real(mu, residual):
     return abs(mu.imag) <= allowance * abs(mu)
 
 
-def _keep(mu, sign, n_modes, residuals=None):
+def _keep(mu, sign, n_modes, residuals):
     """Indices of the real roots μ of ``sign`` (:data:`SIGNS`), nearest zero first
     (:func:`is_real` with the roots' ``residuals``; their real parts are used)."""
-    res = np.zeros(len(mu)) if residuals is None else residuals
-    real = [i for i in range(len(mu)) if is_real(mu[i], res[i])]
+    real = [i for i in range(len(mu)) if is_real(mu[i], residuals[i])]
     wanted = {"positive": lambda m: m > 0, "negative": lambda m: m < 0, "both": lambda m: True}
     return sorted((i for i in real if wanted[sign](mu[i].real)), key=lambda i: abs(mu[i]))[:n_modes]
 
