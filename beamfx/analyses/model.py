@@ -295,7 +295,7 @@ class BeamModel(Discretised):
         :func:`beamfx.io._sections.section_expression`."""
         d = self.discretisation
         u, rot = ufl.split(self.w)[:2]
-        Gamma, K = strains(self.kin, u, self._member_rotation(), d.t0, d.Lam0)
+        Gamma, K = self.strains
         X = ufl.SpatialCoordinate(d.mesh.mesh)
         return (
             X,
