@@ -118,7 +118,7 @@ class BeamModel(Discretised):
         work = 0
         for ld in spec.point_loads:  # constant on a cell: dead forces, moments if θ is linear
             exact = ld.kind == "dead" and not (kin.finite and not kin.plane and any(ld.moment))
-            work += self._history_factor(ld) * d.at_point(ld.at, work_of(ld), exact)
+            work += self._time_factor(ld.history) * d.at_point(ld.at, work_of(ld), exact)
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
             if dl.beam is None:
@@ -127,7 +127,7 @@ class BeamModel(Discretised):
                 on_beam = d.beam_indicator(names.index(dl.beam))
             else:  # the profile at the interpolation points, like a section varying along s
                 on_beam = d.beam_profile(names.index(dl.beam), dl.profile)
-            work += self._history_factor(dl) * on_beam * work_of(dl) * d.dx
+            work += self._time_factor(dl.history) * on_beam * work_of(dl) * d.dx
         if any(spec.gravity):
             rho_A = d.inertia[0]
             work += rho_A * ufl.dot(vec(spec.gravity), displacement(kin, v_u)) * d.dx
@@ -149,10 +149,6 @@ class BeamModel(Discretised):
         if self.hinges is None:
             return parts[1]
         return member_rotation(self.kin, parts[1], parts[2], self.hinges)
-
-    def _history_factor(self, load):
-        """1, or a constant that :meth:`set_time` sets to the load's history f(t)."""
-        return self._time_factor(load.history)
 
     def _time_factor(self, history):
         """1 if ``history`` is None, else a constant that :meth:`set_time` sets to f(t)."""
