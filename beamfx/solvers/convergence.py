@@ -131,8 +131,7 @@ class AbsoluteTangent:
         """ε‖ |A| (|x| + sizes) ‖₂ (``sizes``: local owned array or None). Collective."""
         rows, cols, vals = A.getValuesCSR()
         same = self._pattern is not None and all(
-            a.shape == b.shape and (a == b).all()
-            for a, b in zip(self._pattern, (rows, cols), strict=True)
+            np.array_equal(a, b) for a, b in zip(self._pattern, (rows, cols), strict=True)
         )
         comm = A.getComm()
         if comm.getSize() > 1:  # the copy is collective: every rank or none
