@@ -567,7 +567,7 @@ def _march(model, s, options, prefix, log, reactions=None):
     if balance.moving or reactions:  # the reactions of each step from Newton's last residual
         solver.keep_residual()
     if reactions and s.scheme != "extrapolated":  # (a combination has no residual of its own)
-        reactions.start(dyn, solver.F)
+        reactions.start(dyn, solver.F, balance.f_loads)
     else:
         reactions = None
     projection = Projection(dyn, balance) if s.scheme == "conserving" else None
@@ -603,7 +603,7 @@ def solve_transient(
     ``checkpoint_every`` steps, at the end, before a failure is raised and when the march is
     interrupted (:mod:`beamfx.interrupt`: a SIGINT or SIGTERM stops it at an accepted step,
     ``stopped_by`` then names the signal), with :func:`checkpoint_state`; pass such a state as
-    ``saved`` to go on from it. ``reactions``: its ``start(dyn, residual)`` once, then
+    ``saved`` to go on from it. ``reactions``: its ``start(dyn, residual, loads)`` once, then
     ``reactions(step, t, last, residual)`` at every converged step before the state moves on
     (:class:`~beamfx.analyses.transient_reactions.ReactionSeries`; not with "extrapolated").
 

@@ -57,21 +57,22 @@ class DynamicBalance(NamedTuple):
 
 class TransientReactions:
     """Reactions and balance of a converged time step (``model.w`` = q_{n+1}, the state at
-    t_n not yet moved on). Compiles the inertia forces' form (and the loads', if any) once.
+    t_n not yet moved on). Compiles the inertia forces' form once.
 
     Args:
         dyn: the :class:`~beamfx.analyses.transient.Dynamics`.
         residual: its residual form, compiled (the Newton solver's), assembled when Newton did
             not keep it.
+        loads: ``dyn.loads`` compiled (the energy balance's), None without loads.
     """
 
-    def __init__(self, dyn, residual):
+    def __init__(self, dyn, residual, loads):
         from ..solvers.forms import compile_form
 
         self.model, self.residual = dyn.model, residual
         self.recovery = ReactionRecovery(dyn.model)
         self.inertia = compile_form(dyn.inertia_forces)
-        self.loads = compile_form(dyn.loads) if dyn.loads is not None else None
+        self.loads = loads
         self.free = np.ones(owned_size(dyn.model.W), bool)  # owned, not held
         held = constrained_dofs(dyn.model.bcs)
         self.free[held[held < len(self.free)]] = False
@@ -169,9 +170,10 @@ class ReactionSeries:
         self.csv = ReactionCsv(self.path, comm)
         self.compute = self.latest = None
 
-    def start(self, dyn, residual):
-        """Compile what the reactions need; start (or cut back) the file. Collective."""
-        self.compute = TransientReactions(dyn, residual)
+    def start(self, dyn, residual, loads):
+        """Compile what the reactions need (``residual`` and ``loads``: the compiled forms of
+        :class:`TransientReactions`); start (or cut back) the file. Collective."""
+        self.compute = TransientReactions(dyn, residual, loads)
         points = list(self.compute.recovery.points)
         self.peaks = Peaks(points)
         for cells in self.csv.start(columns(points), self.t_restart):
