@@ -69,7 +69,8 @@ class StrainHistory:
         self.second = fem.Constant(mesh, PETSc.ScalarType(0.0))
         points = _quadrature_points(degree)
         self._strain = fem.Expression(strain_vector(model), points)
-        self._index = _dof_index(self.Q, len(points))
+        index = _dof_index(self.Q, len(points))
+        self._cells, self._index = np.arange(len(index), dtype=np.int32), index.ravel()
         self.dx = d.dx_shear
 
     def rate(self):
@@ -85,10 +86,9 @@ class StrainHistory:
     def _strain_now(self):
         """ε of the model's current unknowns at the quadrature points (local cells, ghosts
         included), as an array in the layout of a Function of ``Q``."""
-        cells = np.arange(len(self._index), dtype=np.int32)
-        values = self._strain.eval(cells).reshape(len(cells), -1)
+        values = self._strain.eval(self._cells)
         out = np.zeros_like(self.fields["strain_n"].x.array)
-        out[self._index.ravel()] = values.ravel()
+        out[self._index] = values.ravel()
         return out
 
     def start(self):
@@ -138,11 +138,8 @@ def _quadrature_points(degree):
 
 def _dof_index(Q, n_points):
     """(local cells, points × 6) array positions of each cell's values in a Function of Q."""
-    dofmap, bs = Q.dofmap, Q.dofmap.index_map_bs
+    bs = Q.dofmap.index_map_bs
     imap = Q.mesh.topology.index_map(Q.mesh.topology.dim)
     n_cells = imap.size_local + imap.num_ghosts
-    index = np.empty((n_cells, n_points * bs), dtype=np.int64)
-    for c in range(n_cells):
-        dofs = dofmap.cell_dofs(c)
-        index[c] = (bs * dofs[:, None] + np.arange(bs)).ravel()
-    return index
+    dofs = Q.dofmap.list.array.reshape(n_cells, n_points).astype(np.int64)
+    return (bs * dofs[:, :, None] + np.arange(bs)).reshape(n_cells, n_points * bs)
