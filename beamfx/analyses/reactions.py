@@ -169,6 +169,7 @@ class ReactionRecovery:
         self.points = {}  # at -> (Dirichlet mask, spring mask)
         self.dofs = {}  # at -> its dofs (located once: 2 ms a call on 16 cells)
         self.rows = {}  # at -> its row of layout.u on the rank that owns it (else none)
+        self.near = {}  # at -> (the layout of its nodes only, their rows of layout.u)
         spring_points = [s.at for s in model.spec.springs]
         spring_points += [s.at for s in model.spec.supports if s.axes == "local"]
         for at in dict.fromkeys([s.at for s in model.spec.supports] + spring_points):
@@ -176,6 +177,7 @@ class ReactionRecovery:
             self.dofs[at] = _vertex_dofs(model, at)
             self.rows[at] = np.flatnonzero(np.isin(self.layout.u[:, 0], self.dofs[at]))[:1]
             at_point[self.dofs[at]] = True
+            self.near[at] = _near(self.layout, self.dofs[at])
             ground = at_point if at in spring_points else np.zeros(n, bool)
             self.points[at] = (at_point & held, ground)
 
@@ -239,9 +241,10 @@ class ReactionRecovery:
         x = positions(model, layout)
         parts = []
         for at, (held, ground) in self.points.items():
-            parts.append(local_resultant(model, layout, residual, held, x))
+            near, u_rows = self.near[at]  # (the other nodes add zeros)
+            parts.append(local_resultant(model, near, residual, held, x[u_rows]))
             if spring is not None and ground.any():
-                parts.append(local_resultant(model, layout, spring, ground, x))
+                parts.append(local_resultant(model, near, spring, ground, x[u_rows]))
             else:  # (every rank adds its part: the reduction is collective)
                 parts.append(np.zeros(8))
             rows = self.rows[at]
@@ -261,6 +264,15 @@ class ReactionRecovery:
             out[at] = Reaction(force.tolist(), about.tolist(), xp.tolist())
         k = 20 * len(self.points)
         return out, sums, [total[k + 8 * j : k + 8 * j + 8] for j in range(len(extra))]
+
+
+def _near(layout, dofs):
+    """The :class:`_Layout` of the owned nodes among ``dofs`` (a point's), and their rows of
+    ``layout.u``: a point's resultant over them is its resultant over all nodes."""
+    u_rows = np.flatnonzero(np.isin(layout.u, dofs).any(1))
+    q_rows = np.flatnonzero(np.isin(layout.q, dofs).any(1))
+    near = _Layout(layout.u[u_rows], layout.axes, layout.X[u_rows], layout.q[q_rows])
+    return near, u_rows
 
 
 def condensed_reactions(model, evaluate):
