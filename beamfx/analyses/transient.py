@@ -116,6 +116,10 @@ class Dynamics:
         self.model, self.settings = model, settings
         W, w, kin, d = model.W, model.w, model.kin, model.discretisation
         self.q_n, self.v_n, self.a_n, self.qdd_n = (fem.Function(W) for _ in range(4))
+        # views of the Functions' values (fixed memory), looked up once: each ``.x.array``
+        # costs a microsecond, and a step asks for them a dozen times
+        self.w_values = w.x.array
+        self.state_values = tuple(f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n))
         # dofs per node: displacement (with the nodes' reference positions) and rotation
         V_u, u_dofs = W.sub(0).collapse()
         self.u_dofs = np.asarray(u_dofs).reshape(-1, kin.displacement_size)
@@ -222,20 +226,19 @@ class Dynamics:
         """Newton's starting point: the step with unchanged acceleration, and the prescribed
         values of the supports at t_{n+1} (a mismatch there would start Newton from a state
         with a sudden strain at the support)."""
-        from dolfinx import fem
+        from dolfinx.cpp.fem import set_bc
 
-        w = self.model.w
-        w.x.array[:] = self.scheme.predict(self.q_n.x.array, self.v_n.x.array, self.a_n.x.array, h)
-        fem.set_bc(w.x.array, self.model.bcs)
+        q_n, v_n, a_n, _ = self.state_values
+        self.w_values[:] = self.scheme.predict(q_n, v_n, a_n, h)
+        set_bc(self.w_values, self.model.bcs, None, 1.0)  # fem.set_bc's call, without its wrapper
 
     def accept(self, h):
         """Move the converged q_{n+1} (in the model's unknowns) into the state at t_n."""
-        arrays = [f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n)]
-        v, a, qdd = self.scheme.advance(self.model.w.x.array, *arrays, h)
-        self.v_n.x.array[:], self.a_n.x.array[:], self.qdd_n.x.array[:] = v, a, qdd
+        q_n, v_n, a_n, qdd_n = self.state_values
+        v_n[:], a_n[:], qdd_n[:] = self.scheme.advance(self.w_values, *self.state_values, h)
         if self.strain_history:
             self.strain_history.accept(h)
-        self.q_n.x.array[:] = self.model.w.x.array
+        q_n[:] = self.w_values
         if self.project_rates:
             self._tangent_rates()
 
@@ -286,6 +289,15 @@ class Dynamics:
             self.strain_history.set_state(arrays)
 
 
+def _assemble_scalar(form):
+    """``dolfinx.fem.assemble_scalar(form)`` (the same call), its import made once."""
+    from dolfinx import fem
+
+    global _assemble_scalar
+    _assemble_scalar = fem.assemble_scalar
+    return fem.assemble_scalar(form)
+
+
 class EnergyBalance:
     """Kinetic and strain energy, work of loads and supports, and dissipation, step by step.
 
@@ -326,9 +338,7 @@ class EnergyBalance:
 
     def scalar(self, form):
         """Value of a compiled scalar form (e.g. ``T``, ``Pi``) over all ranks. Collective."""
-        from dolfinx import fem
-
-        return self._sum(fem.assemble_scalar(form))
+        return self._sum(_assemble_scalar(form))
 
     def _vector(self, form):
         import dolfinx.fem.petsc as fp
@@ -353,7 +363,7 @@ class EnergyBalance:
     def record(self, q_old, h):
         """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0)."""
         owned = slice(0, self.n_owned)
-        q = self.dyn.model.w.x.array[owned].copy()
+        q = self.dyn.w_values[owned].copy()
         now = {
             "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
             "reaction": self.reaction,
@@ -541,7 +551,7 @@ def _accept(m, t, h, q_old, step):
     """Move the state on from ``t`` to t + h (step ``step``) after a converged step (``q_old``
     gets q_n); returns the energy balance at t + h. The support reactions are taken before
     the state moves on: the residual's rates are expressions of the state at t_n."""
-    q_old[:] = m.dyn.q_n.x.array
+    q_old[:] = m.dyn.state_values[0]  # q_n
     if m.dyn.extrapolation:
         m.dyn.extrapolation.accept()
     else:

@@ -71,11 +71,14 @@ def _kinematics(model, names, recover):
         expr, layout, sample = section_evaluator(model, cell_nodes(model.degree), recover)
         rows = [(n, end * model.degree) for n, end in found]  # ξ = 0 or 1
         parts = tuple(layout[k] for k in ("X", "u", "rot"))
-        per_model[key] = (rows, cells, expr, len(sample), parts)
-    rows, cells, expr, n_sample, (X, u, rot) = per_model[key]
+        # the values' array, made once: the compiled expression writes every entry of it
+        buffer = np.zeros((len(cells), expr.X().shape[0] * expr.value_size), expr.dtype)
+        per_model[key] = (rows, cells, expr._cpp_object, buffer, len(sample), parts)
+    rows, cells, expr, buffer, n_sample, (X, u, rot) = per_model[key]
     if not rows:
         return {}
-    values = expr.eval(cells).reshape(len(rows), n_sample, -1)
+    expr.eval(cells, buffer)  # what Expression.eval(cells) does, into the kept array
+    values = buffer.reshape(len(rows), n_sample, -1)
     finite = model.kin.finite
     return {
         n: _kinematic_values(finite, {"X": v[X], "u": v[u], "rot": v[rot]})
