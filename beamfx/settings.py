@@ -140,7 +140,7 @@ def markdown_table(cls, defaults=None):
     """The docs' table of a settings class: key, allowed values, default, meaning.
 
     ``defaults`` overrides the printed default of fields whose default is computed (e.g.
-    ``{"output_every": "about 200 frames per run"}``).
+    ``{"output_every": "about 100 frames per run"}``).
     """
     defaults = defaults or {}
     rows = ["| key | allowed | default | meaning |", "|---|---|---|---|"]

@@ -61,7 +61,7 @@ class Settings:
     damping: Damping = option(Damping(), doc="Rayleigh damping")
     rotary_inertia: str = option("full", choices=("full", "polar", "none"), doc="rotary inertia")
     output_every: int | None = option(
-        None, positive=True, doc="a frame every this many steps (default: about 200 per run)"
+        None, positive=True, doc="a frame every this many steps (default: about 100 per run)"
     )
     checkpoint_every: int = option(50, low=0, doc="steps between checkpoints (0: never)")
     start: str = option("rest", choices=("rest", "static"), doc="from rest or a static state")

@@ -322,7 +322,7 @@ def test_output_policy_every_times_and_last():
     policy = FramePolicy(OutputSettings(times=(0.25, 0.55)))
     policy.resume(0.5)  # restarted at 0.5: 0.25 is done, 0.55 still to come
     assert not policy.want(6, 0.52) and policy.want(7, 0.6)
-    assert default_every("transient", 1440) == 7 and default_every("static", 40) == 1
+    assert default_every("transient", 1440) == 14 and default_every("static", 40) == 1
 
 
 def test_missing_vtk_is_reported_before_the_solve(monkeypatch):
