@@ -39,6 +39,8 @@ from .section_fields import section_kinetic_energy
 from .strain_rates import StrainHistory, bdf2_weights
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
+CHECKPOINT_STEPS = 50  # the default checkpoints: every this many steps,
+CHECKPOINT_SECONDS = 10.0  # and this much wall time after the last one (or the start)
 
 
 @dataclass(frozen=True)
@@ -57,7 +59,9 @@ class TransientSettings:
     damping_stiffness: float = 0.0  # Rayleigh a1 (s): viscous stress a1 C ε̇
     rotary_inertia: str = "full"
     output_every: int = 1  # ParaView frames every n steps (probes and energies every step)
-    checkpoint_every: int = 50  # steps between checkpoints (0: never)
+    # steps between checkpoints (0: never); None: every CHECKPOINT_STEPS steps, at most one per
+    # CHECKPOINT_SECONDS of wall time (each costs a file written and flushed to disk)
+    checkpoint_every: int | None = None
 
     def __post_init__(self):
         if self.scheme == "extrapolated" and self.tolerance is not None:
@@ -610,11 +614,12 @@ def solve_transient(
     (:meth:`Dynamics.error_estimate`) rejects and sizes the steps instead.
     ``on_step(record)`` is called after every accepted step (and at t = 0 with step 0), so
     output is written as the run goes. ``checkpoint(header, arrays)`` is called every
-    ``checkpoint_every`` steps, at the end, before a failure is raised and when the march is
-    interrupted (:mod:`beamfx.interrupt`: a SIGINT or SIGTERM stops it at an accepted step,
-    ``stopped_by`` then names the signal), with :func:`checkpoint_state`; pass such a state as
-    ``saved`` to go on from it. ``reactions``: its ``start(dyn, residual, loads)`` once, then
-    ``reactions(step, t, last, residual)`` at every converged step before the state moves on
+    ``checkpoint_every`` steps (:func:`checkpoint_due`), at the end, before a failure is
+    raised and when the march is interrupted (:mod:`beamfx.interrupt`: a SIGINT or SIGTERM
+    stops it at an accepted step, ``stopped_by`` then names the signal), with
+    :func:`checkpoint_state`; pass such a state as ``saved`` to go on from it.
+    ``reactions``: its ``start(dyn, residual, loads)`` once, then ``reactions(step, t, last,
+    residual)`` at every converged step before the state moves on
     (:class:`~beamfx.analyses.transient_reactions.ReactionSeries`; not with "extrapolated").
 
     Raises:
@@ -638,6 +643,7 @@ def solve_transient(
     if m.projection:
         m.projection.remember()
     records, iterations, stopped_by = [], 0, "t_end"
+    saved_at = [time.perf_counter()]  # wall time of the last checkpoint (or of the start)
     q_old = model.w.x.array.copy()
     while t < s.t_end * (1 - 1e-12):
         h, wanted, report, cutbacks, error = _step(
@@ -658,12 +664,27 @@ def solve_transient(
         if signum:
             stopped_by = reason(signum)
             break
-        if s.checkpoint_every and step % s.checkpoint_every == 0:
+        if checkpoint_due(s.checkpoint_every, step, saved_at, model.comm):
             save(t, step)
+            saved_at[0] = time.perf_counter()
     save(t, step)
     seconds = {"compile": compile_time, **solver.seconds, "total": time.perf_counter() - t_start}
     solver.destroy()
     return TransientResult(tuple(records), iterations, seconds, stopped_by)
+
+
+def checkpoint_due(every, step, saved_at, comm):
+    """Whether accepted step ``step`` gets a checkpoint: every ``every`` steps (0: never); by
+    default (None) every :data:`CHECKPOINT_STEPS` steps once :data:`CHECKPOINT_SECONDS` of
+    wall time have passed since ``saved_at[0]`` (rank 0's clock decides: collective then).
+    A short run then writes its checkpoint at the end only, a long one loses at most about
+    that much work to a killed process."""
+    if every is not None:
+        return bool(every) and step % every == 0
+    if step % CHECKPOINT_STEPS:
+        return False
+    due = time.perf_counter() - saved_at[0] >= CHECKPOINT_SECONDS
+    return comm.bcast(due) if comm.size > 1 else due
 
 
 def _failure(t, dt_min, tried):

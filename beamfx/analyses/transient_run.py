@@ -63,7 +63,12 @@ class Settings:
     output_every: int | None = option(
         None, positive=True, doc="a frame every this many steps (default: about 100 per run)"
     )
-    checkpoint_every: int = option(50, low=0, doc="steps between checkpoints (0: never)")
+    checkpoint_every: int | None = option(
+        None,
+        low=0,
+        doc="steps between checkpoints (0: never); default: every 50 steps, at most one per "
+        "10 s of wall time",
+    )
     start: str = option("rest", choices=("rest", "static"), doc="from rest or a static state")
     steps: int = option(10, positive=True, doc="load steps of a static start")
 

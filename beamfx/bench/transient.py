@@ -65,7 +65,7 @@ def _run(model_spec, settings, probe):
 def scene_settings(settings):
     """The ``[analysis]`` of a transient scene with the integrator's ``settings`` (a
     :class:`~beamfx.analyses.transient.TransientSettings`); output and checkpoints as a scene
-    that does not set them (frames: about 100 per run, a checkpoint every 50 steps)."""
+    that does not set them (frames: about 100 per run, a checkpoint every 50 steps at most one per 10 s)."""
     from ..analyses.transient_run import Damping, Settings
 
     return Settings(
