@@ -92,7 +92,9 @@ def run_scene(
     from .analyses.registry import analysis
     from .io import log as default_log
     from .io.folder import claim
+    from .solvers.forms import remember_loaded_modules
 
+    remember_loaded_modules()  # before the elements' lookup too: a later run here finds them
     comm, t_start = comm or MPI.COMM_WORLD, time.perf_counter()
     log = log or partial(default_log, comm=comm)
     path = Path(path) if path else default_scene_path()
