@@ -286,7 +286,7 @@ def _start(model, settings, ctx):
         static = solve_static(model, steps=settings.steps, options=opts, log=ctx.log)
         ctx.log(f"static start: {static.newton_iterations} Newton iterations")
     if saved is not None:
-        ctx.frames.resume(saved[0]["t"])
+        ctx.frames.resume(saved[0]["t"], saved[0]["step"])
     return saved
 
 

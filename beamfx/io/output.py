@@ -241,11 +241,15 @@ class FrameWriter:
         mesh = surface_mesh(fields, self.model.degree, self.names, self.outlines, ends=self._ends)
         return surface_grid(mesh, arrays, self.grids["surface"])
 
-    def resume(self, t_max):
+    def resume(self, t_max, step=None):
         """Keep the frames up to ``t_max`` of an earlier run in the folder (a restart) and
-        drop later ones with their files."""
+        drop later ones with their files. ``step``: the step at ``t_max`` (a checkpoint's);
+        its frame, written where the earlier run stopped, is dropped too unless ``every``
+        asks for that step, so that the series goes on as an uninterrupted run's."""
+        policy = self.policy
+        inclusive = step is None or policy.by_time or step % policy.every == 0
         for series in self._all_series():
-            series.resume(t_max)
+            series.resume(t_max, inclusive)
         if self.xdmf is not None:
             self.xdmf.resume(t_max)
         self.policy.resume(t_max)

@@ -120,9 +120,13 @@ class VtkSeries:
         self.comm.barrier()
         self.started = True
 
-    def resume(self, t_max):
-        """Keep the frames up to ``t_max`` (relative tolerance 1e-12) of an earlier run."""
-        self._start(lambda t: t <= t_max * (1 + 1e-12) + 1e-300)
+    def resume(self, t_max, inclusive=True):
+        """Keep the frames up to ``t_max`` (relative tolerance 1e-12) of an earlier run; the
+        one at ``t_max`` too if ``inclusive``."""
+        if inclusive:
+            self._start(lambda t: t <= t_max * (1 + 1e-12) + 1e-300)
+        else:
+            self._start(lambda t: t < t_max * (1 - 1e-12))
 
     def write(self, step, time, grid):
         """Frame number ``step`` at ``time``: this rank's piece ``grid``; on a first frame the
