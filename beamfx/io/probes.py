@@ -73,11 +73,11 @@ def _kinematics(model, names, recover):
         parts = tuple(layout[k] for k in ("X", "u", "rot"))
         # the values' array, made once: the compiled expression writes every entry of it
         buffer = np.zeros((len(cells), expr.X().shape[0] * expr.value_size), expr.dtype)
-        per_model[key] = (rows, cells, expr._cpp_object, buffer, len(sample), parts)
+        per_model[key] = (rows, cells, expr, buffer, len(sample), parts)
     rows, cells, expr, buffer, n_sample, (X, u, rot) = per_model[key]
     if not rows:
         return {}
-    expr.eval(cells, buffer)  # what Expression.eval(cells) does, into the kept array
+    expr.eval(cells, buffer)  # into the kept array (Expression.eval's values argument)
     values = buffer.reshape(len(rows), n_sample, -1)
     finite = model.kin.finite
     return {
