@@ -142,6 +142,9 @@ def build_mesh(comm, specs, degree, named_points=None):
     cell = ufl.Cell("interval", geometric_dimension=3)
     # variant="equispaced": FFCx would set it anyway and then miss the JIT cache (notes, P5)
     domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, degree, variant="equispaced"))
+    # cells as the adjacency list the C++ takes: an array makes DOLFINx try and fail first
+    # (a TypeError whose message prints the arrays), then convert
+    cells = dolfinx.cpp.graph.AdjacencyList_int64(np.asarray(cells, np.int64))
     mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain)
 
     original = np.asarray(mesh.topology.original_cell_index)
