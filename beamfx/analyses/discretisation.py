@@ -30,7 +30,6 @@ from ..spec import resolve_point
 from .checks import joint_breaks
 from .section_fields import SectionMatrices, dg_points, is_coupled, matrix_fields
 
-
 #: mesh -> {(degree, size): weak reference to the DG space on it} (weak both ways: a space
 #: refers to its mesh, and lives as long as a field on it)
 _dg_spaces = weakref.WeakKeyDictionary()
