@@ -185,9 +185,7 @@ class CondensedModel(Discretised):
         clamp = fem.locate_dofs_topological(self.W, 0, verts)
         bs = self.W.dofmap.index_map_bs
         zero = np.zeros(bs) if bs > 1 else PETSc.ScalarType(0.0)
-        # the C++ space: the Python one makes DOLFINx fail first (a TypeError whose message
-        # prints the arguments) and retry with it
-        self.bcs = [fem.dirichletbc(zero, clamp, self.W._cpp_object)]
+        self.bcs = [fem.dirichletbc(zero, clamp, self.W)]
         self.coupling = FollowerCoupling(self, self._followers) if self._followers else None
         self._integrator = None
         self._synced = None  # (load factor, w) that ``u`` was last integrated from
