@@ -186,6 +186,10 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         comm: MPI communicator.
         extra_points: names (``beam:where``) that must be mesh vertices too (probes).
     """
+    from ..solvers.forms import remember_loaded_modules
+
+    # before the first space of the process: each element's JIT look-up lists the cache folder
+    remember_loaded_modules()
     # one DOLFINx mesh holds one element type: every beam gets the highest degree asked for
     p = max(b.degree for b in spec.beams)
     named, mesh = _beam_mesh(spec, comm, p, extra_points)
