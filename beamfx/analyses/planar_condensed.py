@@ -173,10 +173,11 @@ class PlanarCondensedModel(CondensedModel):
         return self.degree == 1 and constant
 
     def _data(self):
-        """Per local cell: its cells' indices, chord (3), σ, the in-plane block of
-        A = Λ0 C_N⁻¹ Λ0ᵀ (2 × 2, :func:`compliance_blocks`: the sections and frames are
-        constant in a cell where :meth:`closed_form` holds) and the expression of the section
-        force n at the midpoint (None without forces)."""
+        """Per local cell: its cells' indices, chord (plane complex) and its length, σ, the
+        in-plane block of A = Λ0 C_N⁻¹ Λ0ᵀ (2 × 2, :func:`compliance_blocks`: the sections
+        and frames are constant in a cell where :meth:`closed_form` holds) and the expression
+        of the section force n at the midpoint (None without forces). Built once: the
+        geometry does not change."""
         from dolfinx import fem
 
         from ..solvers.forms import JIT_PARAMS
@@ -201,7 +202,8 @@ class PlanarCondensedModel(CondensedModel):
                 force = fem.Expression(n, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
             block = np.stack([AA[:, [0, 1]], AA[:, [1, 2]]], axis=1)
             sign = np.where(self._flipped[: len(cells)], -1.0, 1.0)
-            self._cell_data = (cells, chord, sign, block, force)
+            c = plane_complex(chord, self.kin.plane)
+            self._cell_data = (cells, c, np.linalg.norm(chord, axis=1), sign, block, force)
         return self._cell_data
 
     def _increments(self, xi):
@@ -215,11 +217,9 @@ class PlanarCondensedModel(CondensedModel):
             turn = self.comm.allreduce(turn, op=MPI.MAX)
             parts = 2 ** int(np.ceil(np.log2(max(1.0, turn / SUBINTERVAL_ANGLE))))
             return self._quadrature_increments(xi, parts)
-        cells, chord, sign, block, force = self._data()
+        cells, c, h, sign, block, force = self._data()
         n_global = force.eval(cells).reshape(-1, 3) if force else np.zeros((len(cells), 3))
         n = plane_complex(n_global, self.kin.plane)
-        c = plane_complex(chord, self.kin.plane)
-        h = np.linalg.norm(chord, axis=1)
         i0, i1 = int(np.argmin(xi)), int(np.argmax(xi))
         du = chord_increments(theta[:, i0], theta[:, i1], c, h, sign, block, n)
         a, b, _ = PLANES[self.kin.plane]

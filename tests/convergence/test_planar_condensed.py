@@ -191,7 +191,7 @@ def test_compliance_blocks_match_the_ufl_frame():
     spec = cantilever(Line((0, 0, 0), (0.6, 0, 0.8)), SEC, 5, 1, force=force, kinematics=XZ)
     model = PlanarCondensedModel(spec, extra_points=["b:end"])
     assert model.closed_form()
-    cells, _, _, block, _ = model._data()
+    cells, _, _, _, block, _ = model._data()
     d = model.discretisation
     A = d.Lam0 * model.compliance * d.Lam0.T
     a, b, _ = PLANES["xz"]
