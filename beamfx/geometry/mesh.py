@@ -151,13 +151,12 @@ def build_mesh(comm, specs, degree, named_points=None):
     domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, degree, variant="equispaced"))
     # cells as the adjacency list the C++ takes: an array makes DOLFINx try and fail first
     # (a TypeError whose message prints the arrays), then convert
-    cells = dolfinx.cpp.graph.AdjacencyList_int64(np.asarray(cells, np.int64))
-    if comm.size == 1:  # one part: every cell stays here, without a call to the graph partitioner
-        mesh = dolfinx.mesh.create_mesh(
-            comm, cells, x, domain, dolfinx.mesh.GhostMode.shared_facet, _serial_partitioner
-        )
+    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(np.asarray(cells, np.int64))
+    if comm.size == 1:  # one part: every cell stays, without a call to the graph partitioner
+        ghosts = dolfinx.mesh.GhostMode.shared_facet  # DOLFINx's default
+        mesh = dolfinx.mesh.create_mesh(comm, adjacency, x, domain, ghosts, _serial_partitioner)
     else:
-        mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain)
+        mesh = dolfinx.mesh.create_mesh(comm, adjacency, x, domain)
 
     original = np.asarray(mesh.topology.original_cell_index)
     tdim = mesh.topology.dim
