@@ -94,8 +94,9 @@ def condition_estimate(A, fixed_rows, limit=LIMIT):
     K, free = gather(A, fixed_rows)
     out = None
     if comm.rank == 0:
-        # dense up to DENSE_LIMIT: SciPy's sparse indexing and products cost more than the SVD
-        K = K.toarray()[np.ix_(free, free)] if len(free) <= DENSE_LIMIT else K[free][:, free]
+        # a matrix of at most DENSE_LIMIT rows dense: SciPy's sparse indexing and products cost
+        # more than the SVD there
+        K = K.toarray()[np.ix_(free, free)] if K.shape[0] <= DENSE_LIMIT else K[free][:, free]
         value, norm = condition(scaled(K))
         unscaled, _ = condition(K)
         out = {
