@@ -64,10 +64,9 @@ def scaled(K):
 
 
 def condition(K):
-    """(κ, norm name) of the square matrix ``K`` (sparse, or dense up to :data:`DENSE_LIMIT`
-    rows): κ₂ by a dense SVD up to
-    :data:`DENSE_LIMIT` rows, else the 1-norm estimate; inf when K is singular to working
-    precision."""
+    """(κ, norm name) of the square matrix ``K`` (sparse; or dense, of at most
+    :data:`DENSE_LIMIT` rows): κ₂ by a dense SVD up to :data:`DENSE_LIMIT` rows, else the
+    1-norm estimate; inf when K is singular to working precision."""
     if K.shape[0] <= DENSE_LIMIT:
         s = np.linalg.svd(K.toarray() if hasattr(K, "toarray") else K, compute_uv=False)
         return (float(s[0] / s[-1]) if s[-1] > 0 else np.inf), "2"
