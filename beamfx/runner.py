@@ -163,7 +163,8 @@ def _refine(scene, comm, log):
     """The scene with the elements and degree that meet its ``[accuracy]``, if it has one."""
     from .analyses.checks import check_supports_for
 
-    check_supports_for(scene.model, scene.settings)
+    if not scene.condense:  # a condensed model is a clamped cantilever (condensed_fit)
+        check_supports_for(scene.model, scene.settings)
     if not scene.accuracy:
         return scene, None
     from .analyses.adaptive import refine_to_tolerance

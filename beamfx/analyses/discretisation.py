@@ -14,6 +14,7 @@ with p Gauss points (``dx_shear``, exact to degree 2p − 1: the locking remedy)
 with p + 1 (``dx``, exact to 2p).
 """
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,20 +30,40 @@ from ..spec import resolve_point
 from .checks import joint_breaks
 from .section_fields import SectionMatrices, dg_points, is_coupled, matrix_fields
 
+#: mesh -> {(degree, size): weak reference to the DG space on it} (weak both ways: a space
+#: refers to its mesh, and lives as long as a field on it)
+_dg_spaces = weakref.WeakKeyDictionary()
+
+
+def dg_space(mesh, degree, size):
+    """The DG ``degree`` space (scalar if ``size`` is 1, else ``size`` components) on ``mesh``:
+    one per mesh, element and size, shared by the cell fields on it (section fields, twist,
+    tangent signs, indicators; each space costs a JIT look-up and a dofmap)."""
+    from dolfinx import fem
+
+    spaces = _dg_spaces.setdefault(mesh, {})
+    known = spaces.get((degree, size))
+    V = known() if known else None
+    if V is None:
+        cell = mesh.ufl_cell()
+        if size == 1:
+            element = ufl.FiniteElement("DG", cell, degree, variant="equispaced")
+        else:
+            element = ufl.VectorElement("DG", cell, degree, dim=size, variant="equispaced")
+        V = fem.FunctionSpace(mesh, element)
+        spaces[degree, size] = weakref.ref(V)
+    return V
+
 
 def cell_field(mesh, degree, values):
     """A DG ``degree`` Function with values (n_cells, points, size) at the interpolation points
-    of each local cell (scalar if size is 1, and then values may be (n_cells, points))."""
+    of each local cell (scalar if size is 1, and then values may be (n_cells, points)), on the
+    mesh's shared space (:func:`dg_space`)."""
     from dolfinx import fem
 
     values = np.asarray(values, float)
     size = 1 if values.ndim == 2 else values.shape[2]
-    cell = mesh.ufl_cell()
-    if size == 1:
-        element = ufl.FiniteElement("DG", cell, degree, variant="equispaced")
-    else:
-        element = ufl.VectorElement("DG", cell, degree, dim=size, variant="equispaced")
-    V = fem.FunctionSpace(mesh, element)
+    V = dg_space(mesh, degree, size)
     f = fem.Function(V)
     n_points = values.shape[1]
     dofs = V.dofmap.list.array.reshape(-1, n_points)[: len(values)]
@@ -165,6 +186,10 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         comm: MPI communicator.
         extra_points: names (``beam:where``) that must be mesh vertices too (probes).
     """
+    from ..solvers.forms import remember_loaded_modules
+
+    # before the first space of the process: each element's JIT look-up lists the cache folder
+    remember_loaded_modules()
     # one DOLFINx mesh holds one element type: every beam gets the highest degree asked for
     p = max(b.degree for b in spec.beams)
     named, mesh = _beam_mesh(spec, comm, p, extra_points)

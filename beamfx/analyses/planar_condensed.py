@@ -65,6 +65,32 @@ def chord_increments(theta0, theta1, chord, h, sign, A, n):
     return bend + strain
 
 
+def cell_values(f, n_cells):
+    """Values (n_cells, size) of a DG0 Function ``f`` on the first ``n_cells`` local cells."""
+    size = f.function_space.dofmap.index_map_bs
+    dofs = f.function_space.dofmap.list.array[:n_cells]
+    return f.x.array.reshape(-1, size)[dofs]
+
+
+def compliance_blocks(t, reference, twist, compliance, plane):
+    """In-plane entries (A_aa, A_ab, A_bb) of A = Λ0 C_N⁻¹ Λ0ᵀ = Σ_k c_k e_k e_kᵀ per cell (rows),
+    (a, b) the plane's axes: Λ0 = (t, e2, e3) from the unit tangent ``t``, the orientation
+    vector ``reference`` and the ``twist`` (radians) as in
+    :func:`~beamfx.physics.kinematics.section_frame`, ``compliance`` the diagonal
+    (c_1, c_2, c_3) of C_N⁻¹. NumPy: no expression to compile for values constant in a cell."""
+    e3 = reference - np.sum(reference * t, axis=1)[:, None] * t
+    e3 = e3 / np.linalg.norm(e3, axis=1)[:, None]
+    e2 = np.cross(e3, t)
+    c, s = np.cos(twist)[:, None], np.sin(twist)[:, None]
+    axes = (t, c * e2 + s * e3, -s * e2 + c * e3)
+    a, b, _ = PLANES[plane]
+
+    def entry(i, j):
+        return sum(compliance[:, k] * axes[k][:, i] * axes[k][:, j] for k in range(3))
+
+    return np.stack([entry(a, a), entry(a, b), entry(b, b)], axis=1)
+
+
 def build_model(model, comm, extra_points=(), condense=False):
     """The model a run solves: the statically condensed one of ``model`` if ``condense``
     (:class:`PlanarCondensedModel` of a planar model, else the spatial
@@ -147,9 +173,11 @@ class PlanarCondensedModel(CondensedModel):
         return self.degree == 1 and constant
 
     def _data(self):
-        """Per local cell: its cells' indices, chord (3), σ, the in-plane block of
-        A = Λ0 C_N⁻¹ Λ0ᵀ (2 × 2) at the midpoint and the expression of the section force n
-        there (None without forces)."""
+        """Per local cell: its cells' indices, chord (plane complex) and its length, σ, the
+        in-plane block of A = Λ0 C_N⁻¹ Λ0ᵀ (2 × 2, :func:`compliance_blocks`: the sections
+        and frames are constant in a cell where :meth:`closed_form` holds) and the expression
+        of the section force n at the midpoint (None without forces). Built once: the
+        geometry does not change."""
         from dolfinx import fem
 
         from ..solvers.forms import JIT_PARAMS
@@ -157,22 +185,25 @@ class PlanarCondensedModel(CondensedModel):
         d, m = self.discretisation, self.mesh.mesh
         if self._cell_data is None:
             cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
-            A = d.Lam0 * self.compliance * d.Lam0.T
-            a, b, _ = PLANES[self.kin.plane]
-            AA = np.zeros((len(cells), 3))  # the Kirchhoff rod: no compliance (UFL's zero)
+            nodes = m.geometry.dofmap.array.reshape(-1, 2)[: len(cells)]
+            chord = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]
+            AA = np.zeros((len(cells), 3))  # the Kirchhoff rod: no compliance
             if self.kin.shear or self.kin.stretch:
-                values = ufl.as_vector([A[a, a], A[a, b], A[b, b]])
-                statics = fem.Expression(values, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
-                AA = statics.eval(cells).reshape(-1, 3)
+                C = cell_values(d.stiffness, len(cells))
+                kept = [self.kin.stretch, self.kin.shear, self.kin.shear]
+                compliance = np.where(kept, 1.0 / C[:, :3], 0.0)
+                t = chord / np.linalg.norm(chord, axis=1)[:, None]  # t0 = J/|J| (P1)
+                reference = cell_values(d.reference, len(cells))
+                twist = cell_values(d.twist, len(cells))[:, 0]
+                AA = compliance_blocks(t, reference, twist, compliance, self.kin.plane)
             force = None  # no forces: n = 0 (and no expression with no domain to compile)
             if self._forces:
                 n = self.load_factor * self.section_force()
                 force = fem.Expression(n, np.array([[0.5]]), jit_params=dict(JIT_PARAMS))
-            nodes = m.geometry.dofmap.array.reshape(-1, 2)[: len(cells)]
-            chord = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]
             block = np.stack([AA[:, [0, 1]], AA[:, [1, 2]]], axis=1)
             sign = np.where(self._flipped[: len(cells)], -1.0, 1.0)
-            self._cell_data = (cells, chord, sign, block, force)
+            c = plane_complex(chord, self.kin.plane)
+            self._cell_data = (cells, c, np.linalg.norm(chord, axis=1), sign, block, force)
         return self._cell_data
 
     def _increments(self, xi):
@@ -186,11 +217,9 @@ class PlanarCondensedModel(CondensedModel):
             turn = self.comm.allreduce(turn, op=MPI.MAX)
             parts = 2 ** int(np.ceil(np.log2(max(1.0, turn / SUBINTERVAL_ANGLE))))
             return self._quadrature_increments(xi, parts)
-        cells, chord, sign, block, force = self._data()
+        cells, c, h, sign, block, force = self._data()
         n_global = force.eval(cells).reshape(-1, 3) if force else np.zeros((len(cells), 3))
         n = plane_complex(n_global, self.kin.plane)
-        c = plane_complex(chord, self.kin.plane)
-        h = np.linalg.norm(chord, axis=1)
         i0, i1 = int(np.argmin(xi)), int(np.argmax(xi))
         du = chord_increments(theta[:, i0], theta[:, i1], c, h, sign, block, n)
         a, b, _ = PLANES[self.kin.plane]
@@ -199,4 +228,11 @@ class PlanarCondensedModel(CondensedModel):
         return inc
 
 
-__all__ = ["PlanarCondensedModel", "build_model", "chord_increments", "plane_complex"]
+__all__ = [
+    "PlanarCondensedModel",
+    "build_model",
+    "cell_values",
+    "chord_increments",
+    "compliance_blocks",
+    "plane_complex",
+]

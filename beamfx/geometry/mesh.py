@@ -110,6 +110,13 @@ def overlapping_cells(specs):
     return None
 
 
+def _serial_partitioner(comm, n_parts, tdim, cells, ghost_mode):
+    """DOLFINx's cell partitioner for one process: the destination of every cell is rank 0."""
+    import dolfinx.cpp
+
+    return dolfinx.cpp.graph.AdjacencyList_int32(np.zeros(cells.num_nodes, np.int32))
+
+
 def build_mesh(comm, specs, degree, named_points=None):
     """Mesh of all beams with isoparametric P_degree geometry on the exact curves.
 
@@ -142,7 +149,14 @@ def build_mesh(comm, specs, degree, named_points=None):
     cell = ufl.Cell("interval", geometric_dimension=3)
     # variant="equispaced": FFCx would set it anyway and then miss the JIT cache (notes, P5)
     domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, degree, variant="equispaced"))
-    mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain)
+    # cells as the adjacency list the C++ takes: an array makes DOLFINx try and fail first
+    # (a TypeError whose message prints the arrays), then convert
+    adjacency = dolfinx.cpp.graph.AdjacencyList_int64(np.asarray(cells, np.int64))
+    if comm.size == 1:  # one part: every cell stays, without a call to the graph partitioner
+        ghosts = dolfinx.mesh.GhostMode.shared_facet  # DOLFINx's default
+        mesh = dolfinx.mesh.create_mesh(comm, adjacency, x, domain, ghosts, _serial_partitioner)
+    else:
+        mesh = dolfinx.mesh.create_mesh(comm, adjacency, x, domain)
 
     original = np.asarray(mesh.topology.original_cell_index)
     tdim = mesh.topology.dim

@@ -48,13 +48,17 @@ class FolderError(OSError):
     collective = True
 
 
+_SYSTEM_PATHS = tuple(Path(s) for s in SYSTEM_FOLDERS)
+
+
 def system_folder(path):
     """The system folder that ``path`` (resolved) is in, or None; ``/`` itself counts."""
     p = Path(path).resolve()
     if p == Path("/"):
         return "/"
-    for s in SYSTEM_FOLDERS:
-        if p == Path(s) or Path(s) in p.parents:
+    enclosing = {p, *p.parents}  # built once, not once per system folder
+    for s, sp in zip(SYSTEM_FOLDERS, _SYSTEM_PATHS):
+        if sp in enclosing:
             return s
     return None
 

@@ -51,20 +51,24 @@ def gather(A, fixed_rows):
 
 
 def scaled(K):
-    """D K D with D = diag(|K_ii|)^(-1/2) (a zero diagonal entry left unscaled); K sparse."""
+    """D K D with D = diag(|K_ii|)^(-1/2) (a zero diagonal entry left unscaled); K sparse, or
+    a dense array (then dense, the same numbers: (d_i K_ij) d_j either way)."""
     import scipy.sparse as sp
 
     d = np.abs(K.diagonal())
-    D = sp.diags(1.0 / np.sqrt(np.where(d > 0, d, 1.0)))
+    D = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
+    if not sp.issparse(K):
+        return D[:, None] * K * D[None, :]
+    D = sp.diags(D)
     return (D @ K @ D).tocsc()
 
 
 def condition(K):
-    """(κ, norm name) of the square sparse matrix ``K``: κ₂ by a dense SVD up to
-    :data:`DENSE_LIMIT` rows, else the 1-norm estimate; inf when K is singular to working
-    precision."""
+    """(κ, norm name) of the square matrix ``K`` (sparse; or dense, of at most
+    :data:`DENSE_LIMIT` rows): κ₂ by a dense SVD up to :data:`DENSE_LIMIT` rows, else the
+    1-norm estimate; inf when K is singular to working precision."""
     if K.shape[0] <= DENSE_LIMIT:
-        s = np.linalg.svd(K.toarray(), compute_uv=False)
+        s = np.linalg.svd(K.toarray() if hasattr(K, "toarray") else K, compute_uv=False)
         return (float(s[0] / s[-1]) if s[-1] > 0 else np.inf), "2"
     from scipy.sparse.linalg import LinearOperator, onenormest, splu
 
@@ -89,7 +93,9 @@ def condition_estimate(A, fixed_rows, limit=LIMIT):
     K, free = gather(A, fixed_rows)
     out = None
     if comm.rank == 0:
-        K = K[free][:, free]
+        # a matrix of at most DENSE_LIMIT rows dense: SciPy's sparse indexing and products cost
+        # more than the SVD there
+        K = K.toarray()[np.ix_(free, free)] if K.shape[0] <= DENSE_LIMIT else K[free][:, free]
         value, norm = condition(scaled(K))
         unscaled, _ = condition(K)
         out = {

@@ -28,6 +28,7 @@ def remember_loaded_modules():
     if getattr(jit.get_cached_module, "beamfx_memo", False):
         return
     _lazy_parameter_log()
+    _expression_signature_once()
     lookup, loaded = jit.get_cached_module, {}
 
     def get_cached_module(module_name, object_names, cache_dir, timeout):
@@ -42,6 +43,80 @@ def remember_loaded_modules():
     get_cached_module.beamfx_memo = True
     get_cached_module.loaded = loaded
     jit.get_cached_module = get_cached_module
+
+
+def _expression_signature_once():
+    """FFCx computes the signature of an expression twice per ``fem.Expression`` (for the
+    module's name, then for the expression's, with the same UFL traversals: its own "FIXME
+    ... cache the computation"), about 0.5 ms each time for a section expression. Its
+    ``compute_signature`` is given a version that keeps the UFL part of the expression
+    just asked for until the next call (the second of the pair, with the same objects) and
+    hashes it with the tag as FFCx does, so the names are FFCx's own (checked in the tests);
+    nothing is kept past the pair."""
+    from ffcx import naming
+
+    if getattr(naming.compute_signature, "beamfx_memo", False):
+        return
+    original, last = naming.compute_signature, [None]
+
+    def compute_signature(ufl_objects, tag):
+        import ufl
+
+        if len(ufl_objects) != 1 or not isinstance(ufl_objects[0], tuple):
+            return original(ufl_objects, tag)
+        expr, points = ufl_objects[0]
+        if not isinstance(expr, ufl.core.expr.Expr):
+            return original(ufl_objects, tag)
+        if last[0] is not None and last[0][0] is expr and last[0][1] is points:
+            part, last[0] = last[0][2], None  # the second call of the pair: let it go
+        else:
+            part = _expression_part(expr, points)
+            last[0] = (expr, points, part)
+        return _combined(part, "expression", tag)
+
+    compute_signature.beamfx_memo, compute_signature.original = True, original
+    naming.compute_signature = compute_signature
+
+
+def _expression_part(expr, points):
+    """The part of FFCx 0.5's ``naming.compute_signature`` that an (expression, points) pair
+    adds: the UFL signature of ``expr`` with its coefficients, constants, arguments and
+    domains renumbered, then ``repr(points)`` (the same steps, in the same order)."""
+    import ufl
+    from ufl.algorithms.analysis import extract_constants, extract_type, unique_tuple
+
+    coeffs = ufl.algorithms.extract_coefficients(expr)
+    consts = extract_constants(expr)
+    args = ufl.algorithms.analysis.extract_arguments(expr)
+    rn = {c: i for i, c in enumerate(coeffs)}
+    rn.update((c, i) for i, c in enumerate(consts))
+    rn.update((c, i) for i, c in enumerate(args))
+    domains = []  # append(*x) as FFCx: one domain each
+    for c in coeffs:
+        domains.append(*c.ufl_domains())
+    for a in args:
+        domains.append(*a.ufl_function_space().ufl_domains())
+    for g in extract_type(expr, ufl.classes.GeometricQuantity):
+        domains.append(*g.ufl_domains())
+    domains += [c.ufl_domain() for c in consts]
+    rn.update((d, i) for i, d in enumerate(unique_tuple(domains)))
+    return ufl.algorithms.signature.compute_expression_signature(expr, rn) + repr(points)
+
+
+def _combined(object_signature, kind, tag):
+    """FFCx 0.5's hash of an object signature, its version and code generation, kind and tag."""
+    import hashlib
+
+    import ffcx.codegeneration
+
+    parts = [
+        object_signature,
+        str(ffcx.__version__),
+        ffcx.codegeneration.get_signature(),
+        kind,
+        tag,
+    ]
+    return hashlib.sha1(";".join(parts).encode("utf-8")).hexdigest()
 
 
 class _Formatted:

@@ -169,3 +169,15 @@ def test_beyond_double_precision_the_failure_says_how_ill_conditioned(tmp_path):
     assert r["converged"] is False and r["status"] == "failed"
     kappa = r["failure"]["condition_estimate"]
     assert kappa["value"] is None or kappa["value"] >= 1e16
+
+
+def test_a_small_tangent_gives_the_same_numbers_dense_and_sparse():
+    """The dense path of a small tangent (no SciPy sparse products) scales and decomposes the
+    same numbers as the sparse one: identical condition numbers, scaled and unscaled."""
+    condition, scaled = conditioning.condition, conditioning.scaled
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(7, 7)) * np.logspace(0, 6, 7)[:, None]
+    K = A @ A.T  # symmetric positive definite, badly scaled
+    for M in (K, K * (np.abs(K) > 1.0)):  # full, and with zeros
+        assert condition(scaled(M)) == condition(scaled(sp.csr_matrix(M)))
+        assert condition(M) == condition(sp.csr_matrix(M))

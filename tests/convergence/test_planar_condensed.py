@@ -175,3 +175,28 @@ def test_a_modal_plane_problem_is_neither_planar_nor_condensed(tmp_path):
     path.write_text(_scene("force = [0, 0, 0.1]", "modal"))
     scene = load_scene(path)
     assert not scene.condense and scene.model.kinematics.plane is None
+
+
+def test_compliance_blocks_match_the_ufl_frame():
+    """The in-plane block of A = Λ0 C_N⁻¹ Λ0ᵀ that the closed-form centre line uses, built in
+    NumPy per cell, equals the UFL expression of the model's own Λ0 and compliance (an
+    inclined beam in the xz plane, shear and stretch kept) to round-off."""
+    import ufl
+    from dolfinx import fem
+
+    from beamfx.geometry import Line
+    from beamfx.physics.kinematics import PLANES
+
+    force = (0.0, 0.0, 5 * SEC.EI_y)
+    spec = cantilever(Line((0, 0, 0), (0.6, 0, 0.8)), SEC, 5, 1, force=force, kinematics=XZ)
+    model = PlanarCondensedModel(spec, extra_points=["b:end"])
+    assert model.closed_form()
+    cells, _, _, _, block, _ = model._data()
+    d = model.discretisation
+    A = d.Lam0 * model.compliance * d.Lam0.T
+    a, b, _ = PLANES["xz"]
+    expr = fem.Expression(ufl.as_vector([A[a, a], A[a, b], A[b, b]]), np.array([[0.5]]))
+    want = expr.eval(cells).reshape(-1, 3)
+    got = np.stack([block[:, 0, 0], block[:, 0, 1], block[:, 1, 1]], axis=1)
+    assert np.allclose(block[:, 0, 1], block[:, 1, 0], rtol=0, atol=0)
+    assert np.abs(got - want).max() <= 1e-15 * np.abs(want).max()

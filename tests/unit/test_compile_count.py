@@ -168,3 +168,35 @@ def test_ffcx_parameter_log_reads_the_same_when_shown(caplog, monkeypatch):
         params = ffcx.parameters.get_parameters({"verbosity": logging.INFO})
     assert pprint.pformat(params) in [r.getMessage() for r in caplog.records]
     ffcx.parameters.get_parameters()  # back to FFCx's default verbosity (WARNING)
+
+
+def test_an_expression_signature_is_ffcx_own_and_computed_once(monkeypatch):
+    """FFCx names an expression's module and the expression by two signatures of the same
+    UFL: the patched ``compute_signature`` (forms.remember_loaded_modules) gives FFCx's own
+    hashes and traverses the expression once for the pair."""
+    import dolfinx
+    import numpy as np
+    import ufl
+    from ffcx import naming
+    from mpi4py import MPI
+    from ufl.algorithms import signature
+
+    from beamfx.solvers.forms import remember_loaded_modules
+
+    remember_loaded_modules()
+    ffcx_own = naming.compute_signature.original
+    mesh = dolfinx.mesh.create_unit_interval(MPI.COMM_WORLD, 2)
+    V = dolfinx.fem.FunctionSpace(mesh, ufl.VectorElement("Lagrange", mesh.ufl_cell(), 2, dim=2))
+    u, c = dolfinx.fem.Function(V), dolfinx.fem.Constant(mesh, 2.0)
+    J = ufl.Jacobian(mesh)[:, 0]
+    expr = ufl.as_vector([c * u[0] * ufl.sqrt(ufl.dot(J, J)), ufl.cos(u[1])])
+    points = np.array([[0.0], [0.5], [1.0]])
+    for tag in ("libffcx_expressions_x", "prefix", "prefix"):
+        assert naming.compute_signature([(expr, points)], tag) == ffcx_own([(expr, points)], tag)
+    dolfinx.fem.Expression(expr, points)  # compiled (FFCx's code generation names it too)
+    calls, traverse = [], signature.compute_expression_signature
+    monkeypatch.setattr(
+        signature, "compute_expression_signature", lambda *a: calls.append(1) or traverse(*a)
+    )
+    dolfinx.fem.Expression(expr, points)  # loaded: the pair of names of one look-up
+    assert len(calls) == 1
