@@ -211,7 +211,9 @@ def _behind(pid, s):
         f"{_g(t)} s: {fx['whole_s'] / t:.2g} x the time. Of beamfx's whole run "
         f"{_g(fx.get('wall_s'))} s is the solve and {_g(rest)} s the rest (model, forms from "
         "the cache, and per step the work outside the Newton solves: probes, output, step "
-        "control)."
+        "control). beamfx's whole run includes writing what `beamfx run` writes (frames, "
+        "probes, reactions, results.json); the Exudyn scripts write no result files "
+        "(writeSolutionToFile = False)."
     )
 
 
