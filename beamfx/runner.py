@@ -197,6 +197,10 @@ def _context(scene, out, comm, log, restart, pictures):
 
     model = _build(scene, comm, log, scene.condense)
     log(f"model: {_trimming(scene, model, scene.condense)[0]}")
+    log(
+        f"model: {_formulation(scene, model)['name']} formulation "
+        f"({_formulation(scene, model)['reason']})"
+    )
     if scene.condense:
         from .analyses.trimming import condensing_summary
 
@@ -248,8 +252,17 @@ def _model_entry(scene, ctx):
         "stretch": kin.stretch,
         "trimming": _trimming(scene, model, condensed)[1],
         "condensed": condensed,
+        "formulation": _formulation(scene, model),
         **({"condensing": _condensing(ctx)} if condensed else {}),
     }
+
+
+def _formulation(scene, model):
+    """The ``formulation`` entry of results.json: displacement or mixed
+    (:mod:`beamfx.analyses.mixed`), and why."""
+    name = "mixed" if getattr(model, "mixed", False) else "displacement"
+    why = scene.trimming.formulation if scene.trimming else ""
+    return {"name": name, "reason": why or "given as a model"}
 
 
 def _condensing(ctx):

@@ -36,11 +36,12 @@ from typing import NamedTuple
 import numpy as np
 import ufl
 
-from ..physics import coupled, energy
+from ..physics import coupled, energy, mixed
 from ..physics.kinematics import strains
 from ..solvers.eigen import solve_eigen
 from ..solvers.forms import compile_form
 from .dofs import constrained_dofs, subspace_dofs
+from .mixed import force_unknowns
 from .modal import to_functions
 
 SIGNS = ("positive", "negative", "both")
@@ -128,12 +129,17 @@ def penalty_tangent(model):
 def stress_stiffness_ufl(model, w_star, dw):
     """K_σ (UFL): second variation at ``model.w`` of ∫ Ṅ·Γ(w) + Ṁ·K(w) ds, with the section
     force and moment rates Ṅ = C_N Γ̇, Ṁ = C_M K̇ (C Γ̇ for a matrix section) at ``w_star`` in the path direction ``dw``
-    (both Functions, held fixed)."""
+    (both Functions, held fixed). In the mixed form Ṅ is the force part of ``dw``: no EA or
+    GA multiplies a small strain rate."""
     kin, d = model.kin, model.discretisation
-    G_star, K_star = strains(kin, *ufl.split(w_star), d.t0, d.Lam0)
+    G_star, K_star = strains(kin, *ufl.split(w_star)[:2], d.t0, d.Lam0)
     G_dot, K_dot = ufl.derivative(G_star, w_star, dw), ufl.derivative(K_star, w_star, dw)
-    Gamma, K = strains(kin, *ufl.split(model.w), d.t0, d.Lam0)
-    if d.matrices is None:
+    Gamma, K = strains(kin, *ufl.split(model.w)[:2], d.t0, d.Lam0)
+    if getattr(model, "mixed", False):  # Ṅ is the path's own section force rate
+        C = None if d.matrices is None else d.matrices.C
+        N_dot = model.section_force(dw)
+        Pi = mixed.stress_work(N_dot, K_dot, Gamma, K, d.C_M, d.dx_shear, d.dx, C)
+    elif d.matrices is None:
         N, M = d.C_N * G_dot, d.C_M * K_dot
         Pi = ufl.dot(N, Gamma) * d.dx_shear + ufl.dot(M, K) * d.dx
     else:  # the same split of the coupled energy as the model's (physics/coupled.py)
@@ -330,6 +336,7 @@ def _inertia(model, K):
         return None
     counter = InertiaCounter(model.comm, "beamfx_buckling_inertia_")
     try:
-        return counter.count(K)
+        return counter.count(K) - force_unknowns(model)
     finally:
         counter.destroy()
+

@@ -10,7 +10,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from ..physics import coupled, energy
+from ..physics import coupled, energy, mixed
 from ..physics.kinematics import displacement, rotation_output, rotation_vector, strains
 from ..physics.rotations import np_quaternion
 from ..spec import DOF_NAMES
@@ -54,8 +54,8 @@ class BeamModel(Discretised):
         self.discretisation = d = discretise(model, comm, extra_points)
         _check_partition(d.mesh.mesh, comm)
         m, p = d.mesh.mesh, d.degree
-        # the quaternion penalty: 10 times the largest EA or GA (before the section limits)
-        self.k_penalty = fem.Constant(m, PETSc.ScalarType(10 * d.stiffness_scale))
+        self.mixed = model.formulation == "mixed"
+        self.k_penalty = fem.Constant(m, PETSc.ScalarType(self._penalty_scale()))
 
         # unknowns: displacement P_k (3) and rotation P_k (quaternion 4, or rotation vector 3)
         cell = m.ufl_cell()
@@ -64,7 +64,11 @@ class BeamModel(Discretised):
         # released joints: the hinge unknowns of the enriched elements (analyses.releases)
         self.hinges = hinge_fields(d, self.kin, model.releases) if model.releases else None
         H = [ufl.VectorElement("DG", cell, 0, dim=HINGE_SIZE)] if model.releases else []
-        self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q, *H]))
+        # the mixed form's section force, DG_{p-1}: the last subspace (``force_index``)
+        size = self.kin.displacement_size
+        N = [ufl.VectorElement("DG", cell, p - 1, dim=size)] if self.mixed else []
+        self.force_index = 2 + len(H) if self.mixed else None
+        self.W = fem.FunctionSpace(m, ufl.MixedElement([U, Q, *H, *N]))
         self.w = fem.Function(self.W, name="unknowns")
         quaternion = self.kin.finite and not self.kin.plane
         self._q0_dofs = subspace_dofs(self.W, 1, 0) if quaternion else []
@@ -89,7 +93,7 @@ class BeamModel(Discretised):
         v_u, v_rot = ufl.split(test)[:2]
         Gamma, K = strains(kin, u, self._member_rotation(), d.t0, d.Lam0)
         self.strains = (Gamma, K)
-        Pi = d.strain_energy(Gamma, K)
+        Pi = self._strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
             Pi += energy.quaternion_penalty(rot, self.k_penalty, d.dx)
         ground = 0  # springs to ground and local-axes supports: their forces are reactions
@@ -141,6 +145,34 @@ class BeamModel(Discretised):
             self.work = work
             self.F -= self.load_factor * work
         self.J = ufl.derivative(self.F, self.w, ufl.TrialFunction(self.W))
+
+    def _penalty_scale(self):
+        """The quaternion penalty k_p: 10 times the largest EA or GA (before the section
+        limits) in the displacement form; in the mixed form, whose tangent holds no EA or GA,
+        10 times the largest bending or torsion stiffness over the shortest element squared
+        (the size of the bending terms on the rotation unknowns)."""
+        d = self.discretisation
+        if not self.mixed:
+            return 10 * d.stiffness_scale
+        bend = d.stiffness.x.array.reshape(-1, 6)[:, 3:]  # diagonals, matrix sections too
+        top = self.comm.allreduce(float(bend.max()) if len(bend) else 0.0, op=MPI.MAX)
+        return 10 * top / d.min_cell_length() ** 2
+
+    def _strain_energy(self, Gamma, K):
+        """The strain energy: the displacement form's, or Π_HR of the section force unknown
+        (:mod:`beamfx.physics.mixed`)."""
+        d = self.discretisation
+        if not self.mixed:
+            return d.strain_energy(Gamma, K)
+        n = self.section_force()
+        S_N = mixed.compliance(self.kin, d.stiffness) if d.matrices is None else None
+        C = None if d.matrices is None else d.matrices.C
+        return mixed.strain_energy(n, Gamma, K, S_N, d.C_M, d.dx_shear, d.dx, C)
+
+    def section_force(self, w=None):
+        """The mixed form's section force (section axes) of ``w`` (default ``self.w``)."""
+        n = ufl.split(self.w if w is None else w)[self.force_index]
+        return mixed.section_force(self.kin, n, self.discretisation.Lam0)
 
     def _member_rotation(self):
         """The rotation field of the members: the node field, with the released relative
@@ -293,13 +325,13 @@ class BeamModel(Discretised):
         u, rot = ufl.split(self.w)[:2]
         Gamma, K = self.strains
         X = ufl.SpatialCoordinate(d.mesh.mesh)
-        return (
-            X,
-            displacement(self.kin, u),
-            rotation_output(self.kin, rot),
-            d.Lam0,
-            *d.resultants(Gamma, K),
-        )
+        N, M = d.resultants(Gamma, K)
+        if self.mixed:  # the unknown itself (C_N Γ is 0·∞ in a rigid limit)
+            N = self.section_force()
+            if d.matrices is not None:
+                A, B, D = coupled.blocks(d.matrices.C)
+                M = B.T * ufl.inv(A) * N + (D - B.T * ufl.inv(A) * B) * K
+        return (X, displacement(self.kin, u), rotation_output(self.kin, rot), d.Lam0, N, M)
 
     def unknowns(self):
         """Global number of unknowns."""

@@ -8,6 +8,7 @@ import numpy as np
 from ..solvers import NewtonSolver, SolveFailed, step_load
 from ..solvers.options import is_iterative
 from ..solvers.stepping import SavedState
+from .mixed import force_unknowns
 
 
 class StaticResult(NamedTuple):
@@ -124,7 +125,8 @@ def solve_static(
 
     def accepted(step):
         if counted is not None:  # the tangent at the converged state, assembled once more
-            counts.append(counted.count(solver.J, solver.bcs, solver.coupling))
+            count = counted.count(solver.J, solver.bcs, solver.coupling)
+            counts.append(count - force_unknowns(model))  # the mixed form's saddle point
         if on_step:
             on_step(step)
 

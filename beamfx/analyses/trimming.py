@@ -42,11 +42,13 @@ PLANE_CHOICES = ("auto", "none", *PLANES)
 
 class Trim(NamedTuple):
     """What the scene builder chose: ``plane`` (None: the full model), ``automatic`` (chosen by
-    :func:`choose_plane` rather than stated) and ``reason`` (a sentence for the log)."""
+    :func:`choose_plane` rather than stated) and ``reason`` (a sentence for the log); and why
+    the formulation (:mod:`beamfx.analyses.mixed`), "" when not chosen by the builder."""
 
     plane: str | None
     automatic: bool
     reason: str
+    formulation: str = ""
 
 
 def _in_plane(model, n, tol):

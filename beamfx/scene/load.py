@@ -75,7 +75,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     point_loads += frames.point_loads
     springs = read_springs(top)
     masses = read_masses(top)
-    plane, condense, kin = _model_table(top.table("model", {}))
+    plane, condense, kin, formulation = _model_table(top.table("model", {}))
     at = top.table("analysis", {})
     analysis, settings = _analysis(at, Model(tuple(beams), tuple(supports)), limits)
     if frames.releases and analysis.name not in RELEASE_ANALYSES:
@@ -116,7 +116,12 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
             f"{file}: supports: none given; the structure is free (rigid-body motion), which "
             "only a modal analysis without pre-stress or a transient from rest can take"
         )
-    model, trimming, condense = choose_model(model, analysis, settings, plane, condense)
+    try:
+        model, trimming, condense = choose_model(
+            model, analysis, settings, plane, condense, formulation
+        )
+    except ValueError as e:  # a formulation the analysis does not take
+        top.fail("model.formulation", str(e))
     accuracy = _accuracy(accuracy_table, probes, analysis.name, limits)
     _check_model(model, file)
     return Scene(
@@ -134,9 +139,12 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
 
 
 def _model_table(mt):
-    """``[model]``: (plane choice, condense choice, :class:`Kinematics`)."""
+    """``[model]``: (plane choice, condense choice, :class:`Kinematics`, formulation choice)."""
+    from ..analyses.mixed import FORMULATIONS
+
     plane = mt.get("plane", str, "auto", choices=PLANE_CHOICES)
     condense = mt.get("condense", str, "auto", choices=("auto", "none"))
+    formulation = mt.get("formulation", str, "auto", choices=FORMULATIONS)
     kin = Kinematics(
         finite=mt.get("kinematics", str, "finite", choices=("finite", "linear")) == "finite",
         shear=mt.get("shear", bool, True),
@@ -144,7 +152,7 @@ def _model_table(mt):
         plane=plane if plane in PLANES else None,
     )
     mt.done()
-    return plane, condense, kin
+    return plane, condense, kin, formulation
 
 
 def _check_size(top, beams, limits):
@@ -247,16 +255,28 @@ def _analysis(t, model, limits):
     return entry, settings
 
 
-def choose_model(model, analysis, settings, plane="auto", condense="auto"):
+def choose_model(model, analysis, settings, plane="auto", condense="auto", formulation="auto"):
     """The model the scene builder solves ``model`` with, for ``analysis`` (a registry
-    entry) and its ``settings``: (model with the planar kinematics where chosen,
-    :class:`~beamfx.analyses.trimming.Trim`, whether it is statically condensed). ``plane``
-    and ``condense`` are the ``[model]`` keys; with both "auto" a static cantilever under point
-    loads in a plane gets the planar condensed model (the angle the only unknown)."""
+    entry) and its ``settings``: (model with the planar kinematics and the formulation where
+    chosen, :class:`~beamfx.analyses.trimming.Trim` with the reasons, whether it is statically
+    condensed). ``plane``, ``condense`` and ``formulation`` are the ``[model]`` keys; with all
+    "auto" a static cantilever under point loads in a plane gets the planar condensed model
+    (the angle the only unknown), and a full model with a huge stiffness ratio the mixed
+    formulation (:func:`~beamfx.analyses.mixed.choose_formulation`).
+
+    Raises:
+        ValueError: ``formulation`` "mixed" for an analysis that does not take it.
+    """
+    from dataclasses import replace
+
+    from ..analyses.mixed import choose_formulation
     from ..analyses.trimming import condensed_fit
 
     model, trimming = _trim(model, plane, analysis, settings)
-    return model, trimming, condense == "auto" and condensed_fit(model, analysis.name) is None
+    condensed = condense == "auto" and condensed_fit(model, analysis.name) is None
+    name, why = choose_formulation(model, analysis.name, formulation, condensed)
+    model = replace(model, formulation=name)
+    return model, trimming._replace(formulation=why), condensed
 
 
 def _trim(model, plane, analysis, settings):

@@ -162,6 +162,9 @@ class Model:
     kinematics: Kinematics = field(default_factory=Kinematics)
     point_masses: tuple = ()
     releases: tuple = ()  #: :class:`Release` of member ends (joints that are not rigid)
+    #: "displacement" (unknowns u, rotation) or "mixed" (and the section force: the
+    #: Hellinger–Reissner form of :mod:`beamfx.physics.mixed`)
+    formulation: str = "displacement"
 
     def beam(self, name):
         """The beam named ``name`` (KeyError if none)."""

@@ -1,0 +1,80 @@
+r"""Which formulation solves a scene: the displacement form or the mixed (Hellinger–Reissner)
+one (:mod:`beamfx.physics.mixed`, issue 16).
+
+In the displacement form the tangent holds EA and GA next to EI/L²: its condition number grows
+with the stiffness ratio ρ = max(EA, GA)·L²/min(EI) (12 (L/h)² for a solid rectangle) and a
+penalty model (shear-rigid, inextensible: ρ ≥ 1e8) sits at the edge of double precision. Buckling
+loads and frequencies then keep only about 16 − log10(ρ) − 5 digits (the stress matrix: Euler's
+load moves 2e-1 at ρ ≈ 1e10). The mixed form carries the section force as an unknown and the
+compliance 1/EA, 1/GA (0 in the rigid limits) instead of EA, GA: its tangent does not grow with
+them.
+
+``[model] formulation``: "displacement", "mixed" or "auto" (the default): the mixed form where
+the analysis takes it (:data:`MIXED_ANALYSES`), the model is not condensed and ρ reaches
+:data:`RATIO_LIMIT`. The limit 1e8 is the penalty of the rigid limits
+(:meth:`~beamfx.physics.sections.Section.with_limits`), so every shear-rigid or inextensible
+model is solved with exact constraints, and lies above every physical section of the
+benchmarks (a rectangle reaches it at L/h ≈ 2900): no existing elastic model changes.
+"""
+
+import numpy as np
+
+FORMULATIONS = ("auto", "displacement", "mixed")
+#: the analyses that solve the mixed form (its force block has no mass and no time history:
+#: the transient, rotating and arc-length runs keep the displacement form)
+MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling")
+#: the stiffness ratio from which "auto" chooses the mixed form (module doc)
+RATIO_LIMIT = 1e8
+
+
+def stiffness_ratio(model, samples=5):
+    """max(EA, GA_y, GA_z)·L² / min(EI_y, EI_z) over the beams of ``model`` (sampled at
+    ``samples`` points along each), the rigid limits of its kinematics applied as penalties
+    (what the displacement form would assemble)."""
+    from ..physics.matrix_sections import section_matrices, with_limits
+
+    kin, worst = model.kinematics, 0.0
+    for b in model.beams:
+        L = b.curve.length
+        C, _ = section_matrices(b.section, np.linspace(0.0, L, samples))
+        C = with_limits(C, not kin.shear, not kin.stretch, L)
+        diag = np.diagonal(C, axis1=1, axis2=2)
+        ratio = diag[:, :3].max(axis=1) * L**2 / diag[:, 4:].min(axis=1)
+        worst = max(worst, float(ratio.max()))
+    return worst
+
+
+def choose_formulation(model, analysis, stated="auto", condensed=False):
+    """(formulation, why) for ``model`` under the analysis named ``analysis``: ``stated``
+    unless it is "auto" (module doc).
+
+    Raises:
+        ValueError: "mixed" stated for an analysis that does not take it.
+    """
+    if stated not in FORMULATIONS:
+        raise ValueError(f"formulation {stated!r}: one of {list(FORMULATIONS)}")
+    if stated == "mixed" and analysis not in MIXED_ANALYSES:
+        raise ValueError(
+            f"the mixed formulation solves the analyses {list(MIXED_ANALYSES)}, not {analysis!r}"
+        )
+    if stated != "auto":
+        return stated, f"stated: [model] formulation = {stated!r}"
+    ratio = stiffness_ratio(model)
+    if condensed:
+        return "displacement", "the condensed model solves it"
+    if analysis not in MIXED_ANALYSES:
+        return "displacement", f"a {analysis} analysis takes the displacement form only"
+    if ratio >= RATIO_LIMIT:
+        return "mixed", f"stiffness ratio max(EA, GA)·L²/EI = {ratio:.2g} ≥ {RATIO_LIMIT:g}"
+    return "displacement", f"stiffness ratio max(EA, GA)·L²/EI = {ratio:.2g} < {RATIO_LIMIT:g}"
+
+
+def force_unknowns(model):
+    """The section force unknowns of the mixed form (0 in the displacement form): each adds
+    one negative eigenvalue to the saddle-point tangent [[A, Bᵀ], [B, −S]] (S ≥ 0, B of full
+    rank), so the inertia of the tangent on (u, θ) is the count less this."""
+    from .dofs import global_size
+
+    if not getattr(model, "mixed", False):
+        return 0
+    return global_size(model.W.sub(model.force_index).collapse()[0])
