@@ -339,4 +339,3 @@ def _inertia(model, K):
         return counter.count(K) - force_unknowns(model)
     finally:
         counter.destroy()
-

@@ -71,15 +71,35 @@ def free_shift(K, M):
 
     min_i K_ii / M_ii (over rows with mass) bounds the lowest ω² from above (Rayleigh quotient
     of a unit vector); 1e-6 of it is far below the lowest elastic ω² of any mesh one would run,
-    yet far above the round-off of the rigid-body eigenvalues.
+    yet far above the round-off of the rigid-body eigenvalues. The mixed formulation's
+    displacement rows have K_ii = 0 (their stiffness is the coupling to the force unknowns):
+    there :func:`row_stiffness` stands for K_ii, which it equals for a positive definite K.
     """
-    k, m = K.getDiagonal(), M.getDiagonal()
-    ka, ma = k.getArray(), m.getArray()
-    ratio = ka[ma > 0] / ma[ma > 0]
+    k, m = row_stiffness(K), M.getDiagonal()
+    ma = m.getArray()
+    ratio = k[ma > 0] / ma[ma > 0]
+    ratio = ratio[ratio > 0]
     local = np.min(ratio) if len(ratio) else np.inf
-    k.destroy()
     m.destroy()
     return -1e-6 * K.getComm().tompi4py().allreduce(local, op=_mpi_min())
+
+
+def row_stiffness(K):
+    """Per owned row i: max(|K_ii|, max_j K_ij² / |K_jj|) over the columns with K_jj ≠ 0. For a
+    positive semi-definite K that is K_ii (Cauchy–Schwarz); for a saddle-point tangent's rows
+    with a zero diagonal, the stiffness their coupling gives them. Collective."""
+    comm = K.getComm().tompi4py()
+    diag = K.getDiagonal()
+    d = np.abs(np.concatenate(comm.allgather(diag.getArray().copy())))
+    diag.destroy()
+    start = K.getOwnershipRange()[0]
+    ai, aj, av = K.getValuesCSR()
+    rows = np.repeat(np.arange(len(ai) - 1), np.diff(ai))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        coupled = np.where(d[aj] > 0, av**2 / d[aj], 0.0)
+    out = d[start : start + len(ai) - 1].copy()
+    np.maximum.at(out, rows, coupled)
+    return out
 
 
 def _mpi_min():

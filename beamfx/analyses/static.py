@@ -133,7 +133,7 @@ def solve_static(
     try:
         history = step_load(solve_at, _State(model.w), steps=n, on_step=accepted, log=log)
     except SolveFailed as e:  # the tangent at the last converged state (restored): κ·eps ≥ 1
-        e.details["condition_estimate"] = tangent_condition(solver)  # says why
+        e.details["condition_estimate"] = tangent_condition(solver, _saddle(model))  # says why
         raise
     finally:
         if counted is not None:
@@ -142,16 +142,17 @@ def solve_static(
     if counted is not None:
         spent["inertia"] = counted.seconds
     t1 = time.perf_counter()
-    kappa = tangent_condition(solver)
+    kappa = tangent_condition(solver, _saddle(model))
     spent["condition"] = time.perf_counter() - t1
     seconds = {"compile": compile_time, **spent, "total": time.perf_counter() - t0}
     its = int(np.sum([h.iterations for h in history]))
     return StaticResult(tuple(history), its, seconds, tuple(counts), kappa)
 
 
-def tangent_condition(solver):
+def tangent_condition(solver, saddle=False):
     """The condition estimate (:mod:`~beamfx.solvers.conditioning`) of the tangent at the
-    solver's current state (assembled once more), or None for a large model. Collective."""
+    solver's current state (assembled once more), or None for a large model; ``saddle``: the
+    mixed formulation's saddle-point tangent. Collective."""
     import dolfinx.fem.petsc as fp
 
     from ..solvers.assembly import assemble_tangent
@@ -165,9 +166,15 @@ def tangent_condition(solver):
         assemble_tangent(A, solver.J, solver.bcs)
         if solver.coupling:
             solver.coupling.add_to_tangent(A)
-        return condition_estimate(A, constrained_rows(solver.bcs, A.getLocalSize()[0]))
+        fixed = constrained_rows(solver.bcs, A.getLocalSize()[0])
+        return condition_estimate(A, fixed, saddle=saddle)
     finally:
         A.destroy()
+
+
+def _saddle(model):
+    """Whether the model's tangent is a saddle point (the mixed formulation)."""
+    return bool(getattr(model, "mixed", False))
 
 
 def _inertia_counter(model, inertia):

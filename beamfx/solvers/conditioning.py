@@ -23,6 +23,7 @@ DENSE_LIMIT = 400
 LIMIT = 2000
 #: what :func:`condition_estimate` reports as its scaling
 SCALING = "symmetric diagonal D K D, D = diag(|K_ii|)^(-1/2) on the free dofs"
+SADDLE_SCALING = "symmetric equilibration D K D (Ruiz, 10 sweeps) on the free dofs"
 
 
 def gather(A, fixed_rows):
@@ -63,6 +64,22 @@ def scaled(K):
     return (D @ K @ D).tocsc()
 
 
+def equilibrated(K, sweeps=10):
+    """D K D with D from ``sweeps`` of Ruiz's symmetric equilibration (each sweep divides row
+    and column i by sqrt(max_j |K_ij|)): the scaling of a saddle-point tangent (the mixed
+    formulation), whose force rows have a small or zero diagonal, so that :func:`scaled`
+    would blow them up by 1/sqrt(compliance). K sparse, or a dense array (then dense)."""
+    import scipy.sparse as sp
+
+    dense = not sp.issparse(K)
+    K = np.array(K, float) if dense else sp.csr_matrix(K)
+    for _ in range(sweeps):
+        r = np.abs(K).max(axis=1) if dense else abs(K).max(axis=1).toarray().ravel()
+        d = 1.0 / np.sqrt(np.where(r > 0, r, 1.0))
+        K = d[:, None] * K * d[None, :] if dense else sp.diags(d) @ K @ sp.diags(d)
+    return K if dense else K.tocsc()
+
+
 def condition(K):
     """(κ, norm name) of the square matrix ``K`` (sparse; or dense, of at most
     :data:`DENSE_LIMIT` rows): κ₂ by a dense SVD up to :data:`DENSE_LIMIT` rows, else the
@@ -83,10 +100,10 @@ def condition(K):
     return float(onenormest(S) * onenormest(inverse)), "1 (estimate)"
 
 
-def condition_estimate(A, fixed_rows, limit=LIMIT):
+def condition_estimate(A, fixed_rows, limit=LIMIT, saddle=False):
     """The condition estimate of the tangent ``A`` on its free dofs, scaled and unscaled, as
     a dict for results.json (same on every rank), or None above ``limit`` unknowns.
-    Collective."""
+    ``saddle``: a saddle-point tangent, scaled by :func:`equilibrated`. Collective."""
     comm = A.getComm().tompi4py()
     if A.getSize()[0] > limit:
         return None
@@ -96,12 +113,12 @@ def condition_estimate(A, fixed_rows, limit=LIMIT):
         # a matrix of at most DENSE_LIMIT rows dense: SciPy's sparse indexing and products cost
         # more than the SVD there
         K = K.toarray()[np.ix_(free, free)] if K.shape[0] <= DENSE_LIMIT else K[free][:, free]
-        value, norm = condition(scaled(K))
+        value, norm = condition(equilibrated(K) if saddle else scaled(K))
         unscaled, _ = condition(K)
         out = {
             "value": _finite(value),
             "unscaled": _finite(unscaled),
-            "scaling": SCALING,
+            "scaling": SADDLE_SCALING if saddle else SCALING,
             "norm": norm,
             "free_unknowns": len(free),
         }
