@@ -84,7 +84,17 @@ class Formulation(Protocol):
 class BeamFormulation(Formulation, Protocol):
     """A :class:`Formulation` with the Simo–Reissner unknowns: ``W`` is the mixed space
     (displacement P_k, rotation P_k), ``W.sub(0)`` the displacement and ``W.sub(1)`` the
-    rotation (quaternion, rotation vector or planar angle, as ``kin`` says)."""
+    rotation (quaternion, rotation vector or planar angle, as ``kin`` says). The mixed
+    (Hellinger–Reissner) formulation adds the section force DG_{k−1} as the last subspace,
+    ``W.sub(force_index)`` (:mod:`beamfx.physics.mixed`); it has no mass."""
+
+    mixed: bool
+    """Whether the section force is an unknown (the Hellinger–Reissner form)."""
+    force_index: object
+    """The subspace of the section force in ``W`` (None in the displacement form)."""
+
+    def section_force(self, w=None):
+        """UFL section force (section axes) of ``w`` (default ``self.w``); mixed form only."""
 
     Pi: object
     """UFL internal energy (strain energy, springs, penalties) of ``w``."""

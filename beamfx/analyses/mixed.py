@@ -10,11 +10,13 @@ compliance 1/EA, 1/GA (0 in the rigid limits) instead of EA, GA: its tangent doe
 them.
 
 ``[model] formulation``: "displacement", "mixed" or "auto" (the default): the mixed form where
-the analysis takes it (:data:`MIXED_ANALYSES`), the model is not condensed and ρ reaches
-:data:`RATIO_LIMIT`. The limit 1e8 is the penalty of the rigid limits
-(:meth:`~beamfx.physics.sections.Section.with_limits`), so every shear-rigid or inextensible
-model is solved with exact constraints, and lies above every physical section of the
-benchmarks (a rectangle reaches it at L/h ≈ 2900): no existing elastic model changes.
+the analysis takes it (:data:`MIXED_ANALYSES`), the model is not condensed, and it is
+shear-rigid or inextensible (exact constraints instead of the penalty 1e8·EI/L² of
+:meth:`~beamfx.physics.sections.Section.with_limits`) or its ρ reaches :data:`RATIO_LIMIT`.
+The limit 1e8 is that penalty's ratio, where the displacement form keeps about 1e-5 of an
+eigen or buckling answer (it loses about 1e-13·ρ); it lies above every elastic section of the
+benchmarks (the stiffest, Mattiasson's, 1e7; a rectangle reaches it at L/h ≈ 2900), so no
+elastic model of them changes.
 """
 
 import numpy as np
@@ -27,14 +29,14 @@ MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling")
 RATIO_LIMIT = 1e8
 
 
-def stiffness_ratio(model, samples=5):
-    """max(EA, GA_y, GA_z)·L² / min(EI_y, EI_z) over the beams of ``model`` (sampled at
+def stiffness_ratio(spec, samples=5):
+    """max(EA, GA_y, GA_z)·L² / min(EI_y, EI_z) over the beams of ``spec`` (sampled at
     ``samples`` points along each), the rigid limits of its kinematics applied as penalties
     (what the displacement form would assemble)."""
     from ..physics.matrix_sections import section_matrices, with_limits
 
-    kin, worst = model.kinematics, 0.0
-    for b in model.beams:
+    kin, worst = spec.kinematics, 0.0
+    for b in spec.beams:
         L = b.curve.length
         C, _ = section_matrices(b.section, np.linspace(0.0, L, samples))
         C = with_limits(C, not kin.shear, not kin.stretch, L)
@@ -44,8 +46,8 @@ def stiffness_ratio(model, samples=5):
     return worst
 
 
-def choose_formulation(model, analysis, stated="auto", condensed=False):
-    """(formulation, why) for ``model`` under the analysis named ``analysis``: ``stated``
+def choose_formulation(spec, analysis, stated="auto", condensed=False):
+    """(formulation, why) for the model ``spec`` under the analysis ``analysis``: ``stated``
     unless it is "auto" (module doc).
 
     Raises:
@@ -59,11 +61,17 @@ def choose_formulation(model, analysis, stated="auto", condensed=False):
         )
     if stated != "auto":
         return stated, f"stated: [model] formulation = {stated!r}"
-    ratio = stiffness_ratio(model)
+    ratio = stiffness_ratio(spec)
     if condensed:
         return "displacement", "the condensed model solves it"
     if analysis not in MIXED_ANALYSES:
         return "displacement", f"a {analysis} analysis takes the displacement form only"
+    kin = spec.kinematics
+    if not (kin.shear and kin.stretch):
+        limits = " and ".join(
+            x for x, on in (("shear-rigid", not kin.shear), ("inextensible", not kin.stretch)) if on
+        )
+        return "mixed", f"{limits}: exact constraints instead of a penalty (ratio {ratio:.2g})"
     if ratio >= RATIO_LIMIT:
         return "mixed", f"stiffness ratio max(EA, GA)·L²/EI = {ratio:.2g} ≥ {RATIO_LIMIT:g}"
     return "displacement", f"stiffness ratio max(EA, GA)·L²/EI = {ratio:.2g} < {RATIO_LIMIT:g}"

@@ -110,7 +110,17 @@ def run_once(case, setting):
                 raise RuntimeError(f"{case.id}: {run.result.status}: {run.result.reason}")
             values.update(read(run.result) if read else run.probes)
             runs.append(run)
-    return case.measure(values), "scene", _condition(runs)
+    return case.measure(values), _path(runs), _condition(runs)
+
+
+def _path(runs):
+    """The run column: `scene`, or `scene (mixed)` when the runs solved the mixed formulation
+    (chosen by the scene builder, :mod:`beamfx.analyses.mixed`; both ran: `scene (mixed,
+    displacement)`)."""
+    names = [(r.model.get("formulation") or {}).get("name", "displacement") for r in runs]
+    if "mixed" not in names:
+        return "scene"
+    return "scene (mixed)" if set(names) == {"mixed"} else "scene (mixed, displacement)"
 
 
 def _condition(runs):
@@ -212,9 +222,10 @@ HEADER = (
     "inextensible models included). Each case at one setting per degree; *move ×1*: the "
     "largest relative change of its values from factor 1 (or the change / the case's scale), "
     "*move prev*: from the previous factor (the trend); *κ*: the condition number of the "
-    "static tangent at the last state, symmetric diagonal scaling (results.json "
-    "`condition_estimate`); *run*: `scene` through `beamfx run`'s path, `own` the case's "
-    "own run, or the cause of a failure."
+    "static tangent at the last state, symmetric diagonal scaling (Ruiz equilibration for the "
+    "mixed formulation's saddle point; results.json `condition_estimate`); *run*: `scene` "
+    "through `beamfx run`'s path (`scene (mixed)`: the builder chose the mixed formulation, "
+    "`[model] formulation`), `own` the case's own run, or the cause of a failure."
 )
 
 

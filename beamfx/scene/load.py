@@ -273,7 +273,11 @@ def choose_model(model, analysis, settings, plane="auto", condense="auto", formu
     from ..analyses.trimming import condensed_fit
 
     model, trimming = _trim(model, plane, analysis, settings)
-    condensed = condense == "auto" and condensed_fit(model, analysis.name) is None
+    condensed = (  # a stated mixed formulation is not condensed
+        condense == "auto"
+        and formulation != "mixed"
+        and condensed_fit(model, analysis.name) is None
+    )
     name, why = choose_formulation(model, analysis.name, formulation, condensed)
     model = replace(model, formulation=name)
     return model, trimming._replace(formulation=why), condensed
