@@ -232,10 +232,12 @@ def _context(scene, out, comm, log, restart, pictures):
 
 def _trimming(scene, model, condensed):
     """(log line, results entry) of the model the scene builder chose for ``model``."""
+    from .analyses.mixed import force_unknowns
     from .analyses.trimming import Trim, trimming_summary
 
     trim = scene.trimming or Trim(model.kin.plane, False, "given as a model")
-    return trimming_summary(trim, model.kin, model.unknowns(), bool(condensed))
+    nodal = model.unknowns() - force_unknowns(model)  # per node: the section force is not
+    return trimming_summary(trim, model.kin, nodal, bool(condensed))
 
 
 def _model_entry(scene, ctx):

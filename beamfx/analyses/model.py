@@ -148,15 +148,20 @@ class BeamModel(Discretised):
 
     def _penalty_scale(self):
         """The quaternion penalty k_p: 10 times the largest EA or GA (before the section
-        limits) in the displacement form; in the mixed form, whose tangent holds no EA or GA,
-        10 times the largest bending or torsion stiffness over the shortest element squared
-        (the size of the bending terms on the rotation unknowns)."""
+        limits). In the mixed form, whose tangent holds no EA or GA, capped at 10 times the
+        penalty of the rigid limits, RATIO_LIMIT·max(EI, GJ)/L² (L the longest beam): the
+        displacement form's k_p below that stiffness ratio, so the two forms have the same
+        discrete equations (k_p moves the answer at the discretisation error: it holds |q| = 1
+        at the quadrature points), and one that no longer grows with EA, GA above it."""
+        from .mixed import RATIO_LIMIT
+
         d = self.discretisation
         if not self.mixed:
             return 10 * d.stiffness_scale
         bend = d.stiffness.x.array.reshape(-1, 6)[:, 3:]  # diagonals, matrix sections too
         top = self.comm.allreduce(float(bend.max()) if len(bend) else 0.0, op=MPI.MAX)
-        return 10 * top / d.min_cell_length() ** 2
+        L = max(b.curve.length for b in self.spec.beams)
+        return 10 * min(d.stiffness_scale, RATIO_LIMIT * top / L**2)
 
     def _strain_energy(self, Gamma, K):
         """The strain energy: the displacement form's, or Π_HR of the section force unknown
