@@ -70,7 +70,7 @@ class RotatingFrame:
 
         kin, w = model.kin, model.w
         test, trial = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
-        (u, rot), (v_u, v_rot) = ufl.split(w), ufl.split(test)
+        (u, rot), (v_u, v_rot) = ufl.split(w)[:2], ufl.split(test)[:2]
         r = relative_position(ufl.SpatialCoordinate(m), displacement(kin, u), self.hub)
         d = model.discretisation
         rho_A = d.inertia[0]
@@ -125,7 +125,7 @@ class RotatingFrame:
 
         model = self.model
         if self._stretch is None:
-            u, rot = ufl.split(model.w)
+            u, rot = ufl.split(model.w)[:2]
             d = model.discretisation
             Gamma, _ = strains(model.kin, u, rot, d.t0, d.Lam0)
             points = np.linspace(0.0, 1.0, model.degree + 2)[:, None]
