@@ -23,9 +23,10 @@ import numpy as np
 
 FORMULATIONS = ("auto", "displacement", "mixed")
 #: the analyses that solve the mixed form (its force block has no mass: the eigen solves by
-#: shift-and-invert take it; the transient and arc-length runs keep the displacement form, not
-#: tried with it)
-MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling", "rotating")
+#: shift-and-invert take it). The rotating analysis runs with it but its quadratic eigen solve
+#: finds a spurious zero mode and moves a flap frequency by 1e-4 (not understood yet); the
+#: transient and arc-length runs were not tried: they keep the displacement form
+MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling")
 #: the stiffness ratio from which "auto" chooses the mixed form (module doc)
 RATIO_LIMIT = 1e8
 

@@ -39,6 +39,7 @@ def test_the_ratio_of_a_rectangle_is_12_slenderness_squared():
         (2.0, Kinematics(shear=False), "static", "mixed"),  # a penalty model
         (2.0, Kinematics(stretch=False), "linear_static", "mixed"),
         (2.0, Kinematics(shear=False), "rotating", "displacement"),
+        (2.0, Kinematics(shear=False), "arclength", "displacement"),
     ],
 )
 def test_auto_choice(L, kin, analysis, chosen):
