@@ -18,6 +18,7 @@ from .checks import check_planar
 from .discretisation import Discretised, discretise
 from .dofs import global_size, subspace_dofs
 from .mechanisms import check_mechanisms
+from .mixed import quaternion_penalty
 from .releases import HINGE_SIZE, hinge_bcs, hinge_fields, member_rotation
 
 
@@ -148,19 +149,10 @@ class BeamModel(Discretised):
 
     def _penalty_scale(self):
         """The quaternion penalty k_p: 10 times the largest EA or GA (before the section
-        limits). The mixed form's tangent holds no EA or GA, and its k_p must not either: 10
-        times the largest bending or torsion stiffness over the shortest element squared (the
-        size of the bending terms on the rotation unknowns). k_p moves the answer at the
-        discretisation error (it holds |q| = 1 at the quadrature points, which the rotation
-        interpolates): the two forms agree to round-off with the same k_p (``k_penalty`` is
-        a Constant), to the discretisation error with their own. The smaller one is the more
-        accurate: 45° bend, 8 × P2, tip error 1.3e-5 with it, 1.1e-3 with 10 EA."""
-        d = self.discretisation
-        if not self.mixed:
-            return 10 * d.stiffness_scale
-        bend = d.stiffness.x.array.reshape(-1, 6)[:, 3:]  # diagonals, matrix sections too
-        top = self.comm.allreduce(float(bend.max()) if len(bend) else 0.0, op=MPI.MAX)
-        return 10 * top / d.min_cell_length() ** 2
+        limits); the mixed form's own (:func:`~beamfx.analyses.mixed.quaternion_penalty`)."""
+        if self.mixed:
+            return quaternion_penalty(self.discretisation)
+        return 10 * self.discretisation.stiffness_scale
 
     def _strain_energy(self, Gamma, K):
         """The strain energy: the displacement form's, or Π_HR of the section force unknown
@@ -168,10 +160,9 @@ class BeamModel(Discretised):
         d = self.discretisation
         if not self.mixed:
             return d.strain_energy(Gamma, K)
-        n = self.section_force()
         S_N = mixed.compliance(self.kin, d.stiffness) if d.matrices is None else None
         C = None if d.matrices is None else d.matrices.C
-        return mixed.strain_energy(n, Gamma, K, S_N, d.C_M, d.dx_shear, d.dx, C)
+        return mixed.strain_energy(self.section_force(), Gamma, K, S_N, d.C_M, d.dx_shear, d.dx, C)
 
     def section_force(self, w=None):
         """The mixed form's section force (section axes) of ``w`` (default ``self.w``)."""
