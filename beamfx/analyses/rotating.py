@@ -201,8 +201,6 @@ def solve_rotating_modes(frame, n_modes=6, options=None, prefix="beamfx_rotating
     t1 = time.perf_counter()
     K, G, M = assemble_operators(frame)
     t2 = time.perf_counter()
-    if frame.model.mixed:  # the force rows (no mass, compliance): balanced by SLEPc's diagonal
-        options = {"pep_scale": "both", **(options or {})}  # scaling too, or TOAR goes astray
     pairs = solve_quadratic(K, G, M, 2 * n_modes + 2, 0.0, prefix, options)
     for A in (K, G, M):
         A.destroy()
