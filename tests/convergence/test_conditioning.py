@@ -75,10 +75,17 @@ def test_the_condition_grows_with_the_stiffness_ratio(tmp_path):
     from beamfx.bench.stress_matrix import stiffened
 
     text = CANTILEVER.format(E=210e9, L=1.0, d=0.02)
-    base = run(tmp_path / "a", text)["condition_estimate"]["value"]
+    displacement = text.replace(
+        'condense = "none"', 'condense = "none"\nformulation = "displacement"'
+    )
+    base = run(tmp_path / "a", displacement)["condition_estimate"]["value"]
     with stiffened(1e4):
-        stiff = run(tmp_path / "b", text)["condition_estimate"]["value"]
+        stiff = run(tmp_path / "b", displacement)["condition_estimate"]["value"]
+        # "auto" takes the mixed form there (ratio 4e8 ≥ 1e8): its saddle point, equilibrated,
+        # keeps the condition of the ordinary beam
+        mixed = run(tmp_path / "c", text)["condition_estimate"]
     assert 1e4 / 3 < stiff / base < 3e4
+    assert mixed["scaling"] == conditioning.SADDLE_SCALING and mixed["value"] < base
 
 
 def test_the_dense_and_the_estimated_norms_agree_on_a_known_matrix():
@@ -119,6 +126,7 @@ degree = 3
 kinematics = "linear"
 shear = false
 plane = "none"
+formulation = "displacement"  # the penalty GA = 1e8 EI/L² ("auto": the mixed form)
 
 [[supports]]
 at = "b:start"
@@ -181,3 +189,17 @@ def test_a_small_tangent_gives_the_same_numbers_dense_and_sparse():
     for M in (K, K * (np.abs(K) > 1.0)):  # full, and with zeros
         assert condition(scaled(M)) == condition(scaled(sp.csr_matrix(M)))
         assert condition(M) == condition(sp.csr_matrix(M))
+
+
+def test_the_mixed_form_solves_it_exactly(tmp_path):
+    """The same cantilever with "auto": the mixed form (shear-rigid: an exact constraint, no
+    penalty) at EA, GA ×1e8 converges by the residual test, the tip deflection is
+    F L³/(3 EI) to round-off (the penalty's 3/1e8 is gone) and κ stays below 1e3."""
+    from beamfx.bench.stress_matrix import stiffened
+
+    with stiffened(1e8):
+        r = run(tmp_path, SHEAR_RIGID.replace('formulation = "displacement"', ""))
+    assert r["converged"] is True and r["model"]["formulation"]["name"] == "mixed"
+    EI = 210e9 * 0.01 * 0.02**3 / 12
+    assert r["probes"]["tip"]["displacement"][2] == pytest.approx(1e4 / (3 * EI), rel=1e-12)
+    assert r["condition_estimate"]["value"] < 1e3
