@@ -43,6 +43,9 @@ def buckling_data(n=None, p=None, q=Q_BELOW):
     data = scene_data("shallow_arch_bifurcation", n, p)
     data["loads"][0]["force_per_length"] = [0.0, -q, 0.0]
     data["model"]["plane"] = "yz"  # the in-plane modes (the 3D arch buckles out of plane first)
+    # the arc-length trace's model (penalty limits; "auto" would take the exact constraints of
+    # the mixed form, 5.7e-6 above the penalty's load at 16 × P3): the same model on both sides
+    data["model"]["formulation"] = "displacement"
     data["analysis"] = {"type": "buckling", "about": "current", "modes": 1, "steps": 5}
     data.pop("probes", None)
     return data

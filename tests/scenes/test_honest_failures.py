@@ -192,6 +192,9 @@ fix = "all"
 at = "a:end"
 force = [0, 0, {P!r}]
 
+[model]  # the displacement form's floor exits ("auto" takes the mixed form from ratio 1e8)
+formulation = "displacement"
+
 [analysis]
 type = "static"
 steps = 10
