@@ -25,6 +25,18 @@ MOVED = (
         "condensed",
         "a static clamped cantilever under tip loads that leave every coordinate plane",
     ),
+    (
+        (
+            "sm21_shear_rigid, sm22_F_z, sm22_M_x, sm26_lateral_buckling, sm28_free_free_eigen, "
+            "sm29_prestressed, lattice_buckling"
+        ),
+        "penalty limits",
+        "mixed formulation",
+        (
+            "shear-rigid or inextensible: exact constraints instead of the penalty 1e8 EI/L² "
+            '([model] formulation = "auto", issue 16)'
+        ),
+    ),
 )
 
 
@@ -57,10 +69,12 @@ def intro_lines():
 
 def formulation(entry):
     """What solved a run, from its results.json ``model`` entry: "planar condensed",
-    "condensed", "planar" or "full"."""
+    "condensed", "planar" or "full", the last two with " mixed" for the mixed formulation."""
     if entry.get("condensed"):
         return "planar condensed" if entry.get("plane") else "condensed"
-    return "planar" if entry.get("plane") else "full"
+    kind = "planar" if entry.get("plane") else "full"
+    mixed = (entry.get("formulation") or {}).get("name") == "mixed"
+    return f"{kind} mixed" if mixed else kind
 
 
 def _kind(row):
