@@ -57,7 +57,7 @@ import numpy as np
 
 from .assembly import assemble_load, assemble_residual, assemble_tangent
 from .bifurcation import CriticalPoint, classify, locate, smallest_eigenpair
-from .convergence import FLOOR_FACTOR, ScaledTest, diagnose, remedy
+from .convergence import ScaledTest, diagnose, remedy
 from .forms import compile_form
 from .inertia import InertiaCounter, counts_inertia, negative_pivots, prepare
 from .options import petsc_options
@@ -223,7 +223,7 @@ class ArcLengthSolver:
         self._rows = constrained_rows(bcs, self.R.getLocalSize())
         self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
-        self._cached, self._prepared, self.effort = None, False, 0
+        self._cached, self._prepared = None, False
 
         n_owned = (
             w.function_space.dofmap.index_map.size_local * w.function_space.dofmap.index_map_bs
@@ -386,7 +386,6 @@ class ArcLengthSolver:
         for it in range(s.max_iterations + 1):
             residuals.append(self._residual(lam_n + dlam))
             if self._converged(it, residuals[-1], lam_n + dlam, ddlam):
-                self.effort = self._effort(it, residuals)
                 return dw, dlam, it, tuple(residuals)
             if residuals[-1] > s.divergence * residuals[0]:
                 raise self._failed("DIVERGED_DTOL", "diverged", residuals)
@@ -430,18 +429,6 @@ class ArcLengthSolver:
         if how == "nan":
             raise self._failed("DIVERGED_FNORM_NAN", "the residual is not finite", [fnorm])
         return how is not None
-
-    def _effort(self, it, residuals):
-        """The corrector iterations that measure the step's nonlinearity, for the step
-        controller: all ``it`` of a step converged by the residual criterion; of one converged
-        at the round-off floor, those until the residual first reached it (FLOOR_FACTOR times
-        the floor). The iterations after only confirm that the increments settle (the floor
-        criterion), a number that does not shrink with the step: counted, they would hold
-        the arc length where the confirmation alone takes ``desired_iterations``."""
-        if self.test.how != "floor" or not self.test.floor:
-            return it
-        at = FLOOR_FACTOR * self.test.floor
-        return next((i for i, r in enumerate(residuals) if r <= at), it)
 
     def _failed(self, reason, why, residuals):
         """_StepFailed of a corrector that stopped with the PETSc-named ``reason``: the cause
@@ -531,7 +518,6 @@ class ArcLengthSolver:
             if taken is None:
                 continue
             dw, dlam, its, res = taken
-            effort = self.effort
             reached = target_load_factor is not None and (
                 (path.lam - target_load_factor) * (path.lam + dlam - target_load_factor) < 0
                 or path.lam + dlam == target_load_factor
@@ -548,7 +534,7 @@ class ArcLengthSolver:
             if stop is not None and stop(path.steps[-1]):
                 reason = "stop"
                 break
-            path.control.accepted(effort)
+            path.control.accepted(its)
         saved.destroy()
         self.lam.value = path.lam
         seconds = {**self.seconds, "total": time.perf_counter() - t_start}
