@@ -44,6 +44,35 @@ def test_a_dependent_case_needs_a_falling_trend():
     assert not ok and "does not fall" in what
 
 
+def test_a_value_tending_to_zero_is_judged_against_its_own_size():
+    """The coupled cantilever's axial tip displacement falls like 1/sqrt(factor): relative to
+    the vanishing value each move stays near 0.9 (it never fell); against the largest
+    |value| over the factors the moves fall by 10 per factor 100, a converged trend."""
+    to_zero = rows([-1.06e-3, -1.31e-4, -1.34e-5, -1.34e-6, -1.34e-7])
+    ok, what = sm.verdict(case("coupled_cantilever"), to_zero)
+    assert ok and what.startswith("trend 9e-01 → 1e-01 → 1e-02 → 1e-03")
+    assert sm.scales(case("c"), to_zero) == {"a": 1.06e-3}
+    assert sm.scales(case("c", scale=10.0), to_zero) == 10.0  # the case's own scale wins
+    # round-off of a quantity that is ~0 counts against the largest size it reached (against
+    # the round-off itself, each move would be 1 or more)
+    noise = rows([1e-3, 1e-15, -1e-15, 2e-15, 0.0])
+    ok, what = sm.verdict(case("c"), noise)
+    assert ok and what == "trend 1e+00 → 2e-12 → 3e-12 → 2e-12 (converges, each value)"
+
+
+def test_a_trend_converges_by_its_last_moves():
+    """Early moves may rise (terms of different powers of 1/factor cancel far from the
+    limit); a converged trend ends with a move at most half of each of the two before, or
+    below the tolerance. A plateau of noise and growing round-off do not converge."""
+    assert sm.falls([2e-2, 6e-6, 2e-5, 2e-6])  # the coupled cantilever's uz
+    assert sm.falls([1e-3, 7e-4, 3e-5, 3e-7])  # bd_static_twisted ux, 4xP3
+    assert sm.falls([5e-3, 1e-3, 2e-3, 1e-7])  # last move below the tolerance
+    assert not sm.falls([3e-4, 4e-5, 1e-6, 1.2e-6])  # a plateau above the tolerance
+    assert not sm.falls([1e-8, 8e-7, 3e-3, 2e-1])  # round-off growing with the factor
+    assert not sm.falls([1e-2, 1e-4, 9e-6, 2e-3])  # falls, then grows again
+    assert not sm.falls([1e-2, 1e-2, 6e-3, 4e-3])  # still moving: not half of the one before
+
+
 def test_a_flag_that_turns_counts_as_a_move_of_one():
     assert sm.move({"steady": 1.0}, {"steady": 0.0}) == 1.0
     assert sm.move({"steady": 0.0}, {"steady": 0.0}) == 0.0
