@@ -75,5 +75,48 @@ def test_first_steps_converge_at_extreme_stiffness(tmp_path):
     assert abs(bifurcation["load_factor"] - expected) <= MODEL_ERROR * expected
 
 
+def test_stiff_dome_factorises_past_mumps_workspace(tmp_path):
+    """The star dome (demos/scenes/star_dome.toml) with EA, GA × 1e2: its first predictor
+    leaves the tangent indefinite with a stiffness ratio whose delayed pivots overflow the
+    workspace MUMPS sized at the analysis (INFOG(1) = -9). Each attempt then failed ("linear
+    solve failed (KSP reason -11)") down to the smallest arc length; factorised again with a
+    larger ICNTL(14) the steps converge and pass the dome's double bifurcation (0 -> 2
+    negative eigenvalues: the asymmetric modes, double by symmetry)."""
+    from beamfx.bench import star_dome
+    from beamfx.bench.stress_matrix import stiffened
+    from beamfx.runner import run_scene
+
+    data = star_dome.scene_data(4, 2)
+    data["analysis"].update(max_steps=3)
+    scene = star_dome.scene(data=data)
+    with stiffened(1e2):
+        run = run_scene(scene.file, tmp_path, log=lambda *a, **k: None, scene=scene)
+    result = run.result
+    assert result.stopped_by == "max_steps" and len(result.load_steps) == 3
+    assert [p["negative_eigenvalues"] for p in result.path][:3] == [0, 0, 2]
+
+
+def test_workspace_is_grown_only_after_mumps_ran_out_of_it():
+    """The retry rule alone: ICNTL(14) four times larger after INFOG(1) = -9 (from MUMPS's
+    default 20 %), nothing after a success, another error or another solver."""
+    from types import SimpleNamespace
+
+    from beamfx.solvers.arclength import _larger_workspace
+
+    def ksp(infog, icntl=20, kind="cholesky", solver="mumps"):
+        F = SimpleNamespace(getMumpsInfog=lambda i: infog, getMumpsIcntl=lambda i: icntl)
+        pc = SimpleNamespace(
+            getType=lambda: kind, getFactorSolverType=lambda: solver, getFactorMatrix=lambda: F
+        )
+        return SimpleNamespace(getPC=lambda: pc)
+
+    assert _larger_workspace(ksp(-9)) == 80
+    assert _larger_workspace(ksp(-9, icntl=80)) == 320
+    assert _larger_workspace(ksp(0)) is None
+    assert _larger_workspace(ksp(-10)) is None  # a singular matrix: no workspace helps
+    assert _larger_workspace(ksp(-9, solver="superlu_dist")) is None
+    assert _larger_workspace(ksp(-9, kind="ilu")) is None
+
+
 if __name__ == "__main__":  # pragma: no cover
     pytest.main([__file__, "-q"])
