@@ -16,8 +16,7 @@ stalls there for ever. :class:`ScaledTest` replaces PETSc's default test (``snes
   ‖F‖ ≤ :data:`FLOOR_LIMIT`·S (or, without any load, the reactions are at the floor too, or
   the floor is the model's own at its reference geometry: a small load on a stiff model, or
   the floor is the model's stiffness ratio at a state within :data:`STATE_RANGE` times the
-  reference sizes and Newton has stopped, its corrections at round-off of the state,
-  ‖du‖ ≤ :data:`ROUNDOFF_TOL`·‖|x| + s‖, and no longer decreasing: EA, GA ≫ EI/L²),
+  reference sizes and Newton's corrections no longer decrease: EA, GA ≫ EI/L²),
   *and* the increment criteria hold: the last correction is small against the state,
   ‖du‖ ≤ :data:`INCREMENT_TOL`·‖|x| + s‖ (or :data:`SETTLED_TOL`·‖|x| + s‖ once the
   corrections stagnate: round-off moves the state, Newton no longer does), and its
@@ -46,9 +45,6 @@ INCREMENT_TOL = 1e-10
 SETTLED_TOL = 1e-6
 #: the energy criterion at the floor (quadratic in the error: INCREMENT_TOL²)
 ENERGY_TOL = 1e-12
-#: a correction at round-off of the state: ‖du‖ ≤ ROUNDOFF_TOL·‖|x| + s‖ (Newton no longer
-#: moves the state by more than some thousand ulps)
-ROUNDOFF_TOL = 1e-12
 #: a floor above FLOOR_LIMIT·S is the model's own (its stiffness ratio) when the state raised
 #: it by at most this factor over the floor of the reference geometry (displacements within
 #: STATE_RANGE node spacings, rotations within STATE_RANGE rad); a larger factor: a state
@@ -227,7 +223,7 @@ class ScaledTest:
         record["floor"] = self.floor
         if fnorm > FLOOR_FACTOR * self.floor:
             return None
-        if not (self._resolvable(fnorm, scale) or self._settled_in_range(record, x)):
+        if not (self._resolvable(fnorm, scale) or self._settled_in_range()):
             return None
         if not self.increment_small(record, x):
             return None
@@ -244,23 +240,24 @@ class ScaledTest:
         geometric = self.geometry_floor >= 0.5 * self.floor
         return fnorm <= FLOOR_LIMIT * scale or unloaded or geometric
 
-    def _settled_in_range(self, record, x):
+    def _settled_in_range(self):
         """Whether a residual at the floor but above FLOOR_LIMIT·S may still be accepted: the
         floor is the model's (its stiffness ratio: EA, GA ≫ EI/L² make eps·|K||x| exceed
         1e-5 of the load at a moderate state), not one a huge state raised (at most
-        :data:`STATE_RANGE` times the reference geometry's), and Newton has stopped: the
-        correction is at round-off of the state (‖du‖ ≤ :data:`ROUNDOFF_TOL`·‖|x| + s‖) and
-        no longer decreases (the last three within a factor 10). The energy criterion is
-        checked after (:meth:`increment_small`). The state is then exact to round-off: its
-        residual is the round-off of the internal forces, not an error of the state."""
+        :data:`STATE_RANGE` times the reference geometry's), and Newton has stopped: its
+        corrections no longer decrease (the last three within a factor 10). The increment
+        and energy criteria are checked after (:meth:`increment_small`): the corrections
+        are then within :data:`SETTLED_TOL` of the state, as for a floor of the reference
+        geometry (:meth:`_resolvable`). The residual is the round-off of the internal
+        forces, not an error of the state: the state is as exact as its corrections say.
+        Corrections at 1e-12 of the state, as asked before, are not reached where the
+        solve's own round-off moves the state more: the Pai beam at EA, GA × 1e6 on 32×P4
+        elements, whose corrections stagnate near 1e-8 of its state as soon as its floor
+        exceeds twice the reference geometry's."""
         if self.floor > STATE_RANGE * self.geometry_floor:
             return False
         steps = [r["step"] for r in self.records[1:]][-3:]
-        if len(steps) < 3 or max(steps) > 10 * min(steps):
-            return False
-        if self.state_norm is None:
-            self.state_norm = self.measure(x)
-        return record["step"] <= ROUNDOFF_TOL * self.state_norm
+        return len(steps) == 3 and max(steps) <= 10 * min(steps)
 
     def linear(self, x, fnorm):
         """The test after one linear solve (``snes_type ksponly``): the residual criterion, or
