@@ -294,7 +294,13 @@ def main(ids=()):
     from . import all_cases
 
     every = {k: c for k, c in all_cases().items() if type(c).__name__ not in SKIP}
-    cases = [every[i] for i in ids if i in every] if ids else list(every.values())
+    unknown = [i for i in ids if i not in every]
+    if unknown:
+        raise SystemExit(
+            f"stress_matrix: unknown case id(s) {unknown}; allowed: {sorted(every)} "
+            "(or --render to rewrite the report from the saved runs)"
+        )
+    cases = [every[i] for i in ids] if ids else list(every.values())
     saved = load() if ids and OUT.with_suffix(".json").exists() else []
     results, failing, findings = [], [], findings_of(OUT)
     OUT.parent.mkdir(parents=True, exist_ok=True)
