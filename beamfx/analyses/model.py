@@ -80,6 +80,7 @@ class BeamModel(Discretised):
         self.penalty_motion = []  # (∂Π/∂f form, f(t) constant) of local supports
         self._build_forms()
         self.bcs, self._bc_values = self._build_supports()
+        self._bc_views = None  # the constants' storage, by _set_supports
         if model.releases:
             self.bcs += hinge_bcs(self.W, self.hinges)
             check_mechanisms(self)
@@ -288,11 +289,19 @@ class BeamModel(Discretised):
     def set_load_factor(self, lam):
         """Scale loads and prescribed values (a prescribed rotation turns by lam times its angle)."""
         self.load_factor.value = lam
+        self._set_supports(lam)
+
+    def _set_supports(self, lam):
+        """The prescribed values at load factor ``lam`` and the current time, written into
+        the constants' storage (a view kept per constant: what ``Constant.value = v`` does,
+        without its copyto dispatch at every step)."""
+        if self._bc_views is None:
+            self._bc_views = [(c._cpp_object.value, v, h) for c, v, h in self._bc_values]
         factors = {None: 1.0}  # each history evaluated once (a support has one per dof)
-        for c, value, history in self._bc_values:
+        for storage, value, history in self._bc_views:
             if history not in factors:
                 factors[history] = float(history(self.time))
-            c.value = value(lam * factors[history])
+            storage[...] = value(lam * factors[history])
 
     def set_time(self, t):
         """Time of a transient: loads and supports with a history take their values at ``t``
@@ -300,7 +309,7 @@ class BeamModel(Discretised):
         self.time = t
         for c, history in self._load_histories:
             c.value = float(history(t))
-        self.set_load_factor(float(self.load_factor.value))
+        self._set_supports(float(self.load_factor.value))
 
     # --- what solvers and writers ask of every model (CondensedModel answers differently) ---
 

@@ -89,6 +89,35 @@ def _check_node(node, text, allowed):
             raise ValueError(f"{_quote(text)}: the number {node.value} is too large") from None
 
 
+class _IgnoreAll:
+    """``np.errstate(all="ignore")`` through NumPy 1's error object directly: the same mask
+    (every floating-point error ignored) at a tenth of the cost, for a history evaluated at
+    one time per step; reentrant (the previous object is kept per entry)."""
+
+    __slots__ = ("saved",)
+
+    def __enter__(self):
+        self.saved.append(_GETERROBJ())
+        size, _, call = self.saved[-1]
+        _SETERROBJ([size, 0, call])  # mask 0: ignore all
+
+    def __exit__(self, *exc):
+        _SETERROBJ(self.saved.pop())
+
+
+_GETERROBJ = getattr(np, "geterrobj", None)  # NumPy 1 only
+_SETERROBJ = getattr(np, "seterrobj", None)
+_IGNORE = _IgnoreAll()
+_IGNORE.saved = []
+
+
+def _ignoring_errors(ndim):
+    """A context that ignores floating-point errors: the cheap one for a single value."""
+    if ndim or _SETERROBJ is None:
+        return np.errstate(all="ignore")
+    return _IGNORE
+
+
 def compile_expression(text, variable, constants=None):
     """A vectorised function of ``variable`` from an expression string.
 
@@ -106,7 +135,7 @@ def compile_expression(text, variable, constants=None):
     def f(x):
         x = np.asarray(x, float)
         try:
-            with np.errstate(all="ignore"):  # non-finite results are the caller's to report
+            with _ignoring_errors(x.ndim):  # non-finite results are the caller's to report
                 y = eval(code, scope, {variable: x})
         except (OverflowError, ZeroDivisionError) as e:  # float arithmetic of constants
             raise ValueError(f"{_quote(text)}: {e}") from None
