@@ -18,6 +18,7 @@ from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_ro
 from ._sections import cell_nodes, evaluate, section_evaluator
 
 _plans = weakref.WeakKeyDictionary()  # model -> {names: (found, cells)}
+_ZERO = (0.0, 0.0, 0.0)  # the rotation before the first step
 
 
 def _locate(model, name):
@@ -64,27 +65,28 @@ def _kinematics(model, names, recover):
     expression of :func:`~beamfx.io._sections.evaluate` (the same numbers) without its
     per-call set-up; what a history asks at every step. Its plan is cached per model,
     names and ``recover`` (the expression's points)."""
-    per_model = _plans.setdefault(model, {})
+    per_model = _plans.get(model)
     key = ("kinematics", tuple(names), recover)
-    if key not in per_model:
+    plan = per_model.get(key) if per_model is not None else None
+    if plan is None:
         found, cells = _plan(model, names)
         expr, layout, sample = section_evaluator(model, cell_nodes(model.degree), recover)
         rows = [(n, end * model.degree) for n, end in found]  # ξ = 0 or 1
         parts = tuple(layout[k] for k in ("X", "u", "rot"))
         # the values' array, made once: the compiled expression writes every entry of it
         buffer = np.zeros((len(cells), expr.X().shape[0] * expr.value_size), expr.dtype)
-        per_model[key] = (rows, cells, expr, buffer, len(sample), parts)
-    rows, cells, expr, buffer, n_sample, (X, u, rot) = per_model[key]
+        values = buffer.reshape(len(rows), len(sample), expr.value_size)  # a view of it
+        plan = _plans[model][key] = (rows, cells, expr, buffer, values, parts)
+    rows, cells, expr, buffer, values, (X, u, rot) = plan
     if not rows:
         return {}
     expr.eval(cells, buffer)  # into the kept array (Expression.eval's values argument)
-    values = buffer.reshape(len(rows), n_sample, -1)
     finite = model.kin.finite
-    return {
-        n: _kinematic_values(finite, {"X": v[X], "u": v[u], "rot": v[rot]})
-        for i, (n, node) in enumerate(rows)
-        for v in (values[i, node],)
-    }
+    out = {}
+    for i, (n, node) in enumerate(rows):
+        v = values[i, node]
+        out[n] = _kinematic_values(finite, v[X], v[u], v[rot])
+    return out
 
 
 def _point_values(finite, v):
@@ -105,10 +107,9 @@ def _point_values(finite, v):
     return out
 
 
-def _kinematic_values(finite, v):
+def _kinematic_values(finite, X, u, rot):
     """``position``, ``displacement`` and the rotation (``quaternion`` of finite kinematics,
     else ``rotation_vector``) of one point: :func:`_point_values` without the rest."""
-    X, u, rot = v["X"], v["u"], v["rot"]
     out = {"position": (X + u).tolist(), "displacement": u.tolist()}
     if finite:
         out["quaternion"] = (rot / math.sqrt(rot.dot(rot))).tolist()  # np.linalg.norm, bitwise
@@ -159,10 +160,13 @@ def evaluate_points(model, names=None, recover=True, full=True):
     else:
         local = _kinematics(model, names, recover)
 
-    result = {}
-    for part in comm.allgather(local) if comm.size > 1 else [local]:
-        for n, v in part.items():
-            result.setdefault(n, v)
+    if comm.size == 1:
+        result = local
+    else:
+        result = {}
+        for part in comm.allgather(local):
+            for n, v in part.items():
+                result.setdefault(n, v)
     missing = [n for n in names if n not in result]
     if missing:  # every rank sees the same gathered result, so all raise together
         raise RuntimeError(f"named points {missing} were found on no rank")
@@ -189,7 +193,9 @@ def track_rotations(previous, current):
     previous = previous or {}
     for name, v in current.items():
         before = previous.get(name, {})
-        prev = before.get("rotation_vector_unwrapped", before.get("rotation_vector", np.zeros(3)))
+        prev = before.get("rotation_vector_unwrapped")
+        if prev is None:
+            prev = before.get("rotation_vector", _ZERO)
         if "quaternion" in v:
             theta = unwrap_rotation_vector(v["quaternion"], prev)
         else:  # linear kinematics: θ is already the field

@@ -157,13 +157,23 @@ def unwrap_rotation_vector(q, previous):
     k gives the turns the other way about n). Keeping the one nearest to the previous value
     follows a rotation past π, 2π, 4π along a load or time path.
     """
-    axis, angle = axis_angle(q)
+    # :func:`axis_angle`'s operations (the norms through ``dot``, arctan2 through NumPy),
+    # the axis divided in plain floats (the same IEEE quotients as the array's)
+    q = np.asarray(q, dtype=float)
+    q = q / _norm(q)
+    s = _norm(q[1:])
+    angle = float(2 * np.arctan2(s, q[0]))  # in [0, 2π]
+    if s > 1e-300:
+        _, a, b, c = q.tolist()
+        n = [a / s, b / s, c / s]
+    else:
+        n = [1.0, 0.0, 0.0]
     prev = np.asarray(previous, dtype=float)
     k0 = math.ceil(_norm(prev) / (2 * np.pi))
     # |(φ + 2πk) n - prev| is least at the integer nearest to (n·prev - φ)/2π: of the turns
     # -k0-2 .. k0+2 only that one and its neighbours are compared, in plain floats (the same
     # operations as arrays of all the turns would do, at a tenth of the cost per call)
-    n, p = [float(x) for x in axis], [float(x) for x in prev]
+    p = prev.tolist()
     centre = round((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - angle) / (2 * np.pi))
     best = None
     for k in range(max(centre - 1, -k0 - 2), min(centre + 1, k0 + 2) + 1):
