@@ -5,6 +5,8 @@ steps), and the grid of a frame of ``reactions.pvd`` (:func:`reaction_grid`, wri
 themselves are :mod:`beamfx.analyses.reactions` and :mod:`beamfx.analyses.transient_reactions`.
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 AXES = ("x", "y", "z")
@@ -100,8 +102,18 @@ def reaction_grid(reactions, build=None):
         key: np.array([r[key] for r in rows], float).reshape(n, 3) for key in ("force", "moment")
     }
     points = np.array([r["position"] for r in rows], float).reshape(n, 3)
-    cells = (np.arange(n), np.arange(n + 1), np.full(n, VTK_VERTEX))
-    return (build or unstructured_grid)(points, *cells, data)
+    return (build or unstructured_grid)(points, *_vertex_cells(n, VTK_VERTEX), data)
+
+
+@lru_cache(maxsize=8)
+def _vertex_cells(n, vertex):
+    """(connectivity, offsets, types) of ``n`` vertex cells, read only and cached: a series
+    finds the same arrays at every frame (a :class:`~beamfx.io.vtkfiles.GridBuffer` then
+    compares nothing)."""
+    cells = (np.arange(n), np.arange(n + 1), np.full(n, vertex))
+    for a in cells:
+        a.flags.writeable = False
+    return cells
 
 
 __all__ = ["AXES", "ReactionCsv", "columns", "reaction_grid", "static_row"]
