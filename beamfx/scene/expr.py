@@ -92,30 +92,27 @@ def _check_node(node, text, allowed):
 class _IgnoreAll:
     """``np.errstate(all="ignore")`` through NumPy 1's error object directly: the same mask
     (every floating-point error ignored) at a tenth of the cost, for a history evaluated at
-    one time per step; reentrant (the previous object is kept per entry)."""
+    one time per step. One object per use (NumPy's error object is per thread)."""
 
     __slots__ = ("saved",)
 
     def __enter__(self):
-        self.saved.append(_GETERROBJ())
-        size, _, call = self.saved[-1]
-        _SETERROBJ([size, 0, call])  # mask 0: ignore all
+        self.saved = old = _GETERROBJ()
+        _SETERROBJ([old[0], 0, old[2]])  # buffer size and callback kept; mask 0: ignore all
 
     def __exit__(self, *exc):
-        _SETERROBJ(self.saved.pop())
+        _SETERROBJ(self.saved)
 
 
 _GETERROBJ = getattr(np, "geterrobj", None)  # NumPy 1 only
 _SETERROBJ = getattr(np, "seterrobj", None)
-_IGNORE = _IgnoreAll()
-_IGNORE.saved = []
 
 
 def _ignoring_errors(ndim):
     """A context that ignores floating-point errors: the cheap one for a single value."""
     if ndim or _SETERROBJ is None:
         return np.errstate(all="ignore")
-    return _IGNORE
+    return _IgnoreAll()
 
 
 def compile_expression(text, variable, constants=None):
