@@ -293,10 +293,10 @@ class BeamModel(Discretised):
 
     def _set_supports(self, lam):
         """The prescribed values at load factor ``lam`` and the current time, written into
-        the constants' storage (a view kept per constant: what ``Constant.value = v`` does,
+        the constants' storage (the view ``Constant.value`` returns, kept: what ``.value = v`` does,
         without its copyto dispatch at every step)."""
         if self._bc_views is None:
-            self._bc_views = [(c._cpp_object.value, v, h) for c, v, h in self._bc_values]
+            self._bc_views = [(c.value, v, h) for c, v, h in self._bc_values]
         factors = {None: 1.0}  # each history evaluated once (a support has one per dof)
         for storage, value, history in self._bc_views:
             if history not in factors:
