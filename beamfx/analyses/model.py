@@ -46,11 +46,13 @@ class BeamModel(Discretised):
     penalty springs.
     """
 
-    #: where the quaternion penalty sees |q|: "quadrature" (the model's ``dx``, the default) or
-    #: "nodal" (only at the nodes of q: :func:`~beamfx.physics.energy.nodal_measure`)
+    #: where the quaternion penalty sees |q|: "quadrature" (the model's ``dx``) or "nodal" (only
+    #: at the nodes of q: :func:`~beamfx.physics.energy.nodal_measure`, which cannot lock)
     PENALTY_RULES = ("quadrature", "nodal")
+    #: the rule of a model built without ``penalty_rule`` (an internal switch for studies)
+    penalty_rule_default = "quadrature"
 
-    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=(), penalty_rule="quadrature"):
+    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=(), penalty_rule=None):
         from dolfinx import fem
         from petsc4py import PETSc
 
@@ -60,6 +62,7 @@ class BeamModel(Discretised):
         _check_partition(d.mesh.mesh, comm)
         m, p = d.mesh.mesh, d.degree
         self.mixed = model.formulation == "mixed"
+        penalty_rule = penalty_rule or self.penalty_rule_default
         if penalty_rule not in self.PENALTY_RULES:
             raise ValueError(f"penalty_rule {penalty_rule!r}: one of {list(self.PENALTY_RULES)}")
         self.penalty_rule = penalty_rule

@@ -67,3 +67,12 @@ def test_nodal_penalty_does_not_depend_on_k_p():
             assert drift_stiff < 1e-3 * drift[rule], (drift[rule], drift_stiff)
     assert moved["nodal"] < drift["nodal"], (moved, drift)
     assert moved["quadrature"] > 1e-4, moved
+
+
+def test_default_rule_is_unchanged():
+    """The model's default is still the Gauss rule of ``dx`` (changing it moves bench values);
+    an unknown rule is refused."""
+    spec = _bend45(1, 2)
+    assert BeamModel(spec).penalty_rule == "quadrature"
+    with pytest.raises(ValueError, match="penalty_rule"):
+        BeamModel(spec, penalty_rule="gauss")
