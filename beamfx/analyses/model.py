@@ -107,7 +107,7 @@ class BeamModel(Discretised):
         self.strains = (Gamma, K)
         Pi = self._strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
-            Pi += energy.quaternion_penalty(rot, self.k_penalty, self._penalty_measure())
+            Pi += energy.quaternion_penalty(rot, self.k_penalty, self.penalty_measure())
         ground = 0  # springs to ground and local-axes supports: their forces are reactions
         for sp in spec.springs:
             k_u, k_r = [float(k) for k in sp.stiffness], [float(k) for k in sp.rotational]
@@ -165,7 +165,7 @@ class BeamModel(Discretised):
             return quaternion_penalty(self.discretisation)
         return 10 * self.discretisation.stiffness_scale
 
-    def _penalty_measure(self):
+    def penalty_measure(self):
         """The measure of the quaternion penalty (:attr:`PENALTY_RULES`)."""
         d = self.discretisation
         if self.penalty_rule == "nodal":
