@@ -46,7 +46,13 @@ class BeamModel(Discretised):
     penalty springs.
     """
 
-    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=()):
+    #: where the quaternion penalty sees |q|: "quadrature" (the model's ``dx``) or "nodal" (only
+    #: at the nodes of q: :func:`~beamfx.physics.energy.nodal_measure`, which cannot lock)
+    PENALTY_RULES = ("quadrature", "nodal")
+    #: the rule of a model built without ``penalty_rule`` (an internal switch for studies)
+    penalty_rule_default = "quadrature"
+
+    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=(), penalty_rule=None):
         from dolfinx import fem
         from petsc4py import PETSc
 
@@ -56,6 +62,10 @@ class BeamModel(Discretised):
         _check_partition(d.mesh.mesh, comm)
         m, p = d.mesh.mesh, d.degree
         self.mixed = model.formulation == "mixed"
+        penalty_rule = penalty_rule or self.penalty_rule_default
+        if penalty_rule not in self.PENALTY_RULES:
+            raise ValueError(f"penalty_rule {penalty_rule!r}: one of {list(self.PENALTY_RULES)}")
+        self.penalty_rule = penalty_rule
         self.k_penalty = fem.Constant(m, PETSc.ScalarType(self._penalty_scale()))
 
         # unknowns: displacement P_k (3) and rotation P_k (quaternion 4, or rotation vector 3)
@@ -97,7 +107,7 @@ class BeamModel(Discretised):
         self.strains = (Gamma, K)
         Pi = self._strain_energy(Gamma, K)
         if kin.finite and not kin.plane:
-            Pi += energy.quaternion_penalty(rot, self.k_penalty, d.dx)
+            Pi += energy.quaternion_penalty(rot, self.k_penalty, self.penalty_measure())
         ground = 0  # springs to ground and local-axes supports: their forces are reactions
         for sp in spec.springs:
             k_u, k_r = [float(k) for k in sp.stiffness], [float(k) for k in sp.rotational]
@@ -154,6 +164,13 @@ class BeamModel(Discretised):
         if self.mixed:
             return quaternion_penalty(self.discretisation)
         return 10 * self.discretisation.stiffness_scale
+
+    def penalty_measure(self):
+        """The measure of the quaternion penalty (:attr:`PENALTY_RULES`)."""
+        d = self.discretisation
+        if self.penalty_rule == "nodal":
+            return energy.nodal_measure(d.mesh.mesh, self.W.sub(1).ufl_element())
+        return d.dx
 
     def _strain_energy(self, Gamma, K):
         """The strain energy: the displacement form's, or Π_HR of the section force unknown

@@ -27,6 +27,40 @@ def quaternion_penalty(q, k_p, dx):
     return 0.5 * k_p * (ufl.dot(q, q) - 1) ** 2 * dx
 
 
+def nodal_rule(element):
+    """(points, weights) on the reference interval whose points are the nodes of the Lagrange
+    ``element`` (a UFL element on an interval, vector or scalar) and whose weights are the
+    integrals of its basis functions: the interpolatory rule on the nodes (Simpson's for P2;
+    Gauss–Lobatto–Legendre, exact to degree 2k − 1, for DOLFINx's default GLL-warped P_k).
+
+    A penalty integrated with it sees the field only at its nodes: one condition per node,
+    which fixes the nodal norms and never reaches the direction field between them (``dx``'s
+    Gauss rule has k + 1 points per element where the element has k nodes of its own)."""
+    import basix
+    from ffcx.element_interface import convert_element
+
+    if element.num_sub_elements():
+        element = element.sub_elements()[0]
+    basis = convert_element(element).element
+    x, w = basix.make_quadrature(basix.CellType.interval, 2 * basis.degree)
+    weights = basis.tabulate(0, x)[0, :, :, 0].T @ w
+    return tuple((float(p),) for p in basis.points[:, 0]), tuple(float(v) for v in weights)
+
+
+def nodal_measure(mesh, element):
+    """The cell measure of :func:`nodal_rule` (a custom FFCx quadrature) on ``mesh``."""
+    import ufl
+
+    points, weights = nodal_rule(element)
+    metadata = {
+        "quadrature_rule": "custom",
+        "quadrature_degree": 2 * element.degree() - 1,
+        "quadrature_points": points,
+        "quadrature_weights": weights,
+    }
+    return ufl.dx(domain=mesh, metadata=metadata)
+
+
 def force_work(kin, rot, v_u, force, follower):
     """Virtual work of a force (global axes); a follower force is R·force (turns with the section)."""
     import ufl
