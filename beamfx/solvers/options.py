@@ -56,8 +56,8 @@ LINEAR = {
         "ksp_type": "cg",
         "ksp_rtol": 1e-12,
         "ksp_max_it": 5000,
-        "pc_type": "gamg",
-        "pc_gamg_type": "agg",
+        "pc_type": "hypre",
+        "pc_hypre_type": "boomeramg",
     },
 }
 

@@ -6,6 +6,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .assembly import assemble_residual, assemble_tangent, prescribed
+from .blocked import use_node_blocks
 from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
 from .options import expand_linear, petsc_options
@@ -122,6 +123,7 @@ class NewtonSolver:
         with petsc_options(prefix, self.options):
             snes.setFromOptions()
             snes.getKSP().setFromOptions()
+            self.blocks = use_node_blocks(snes.getKSP(), w)  # AMG on whole beam nodes
         self.test = ScaledTest(self)
         snes.setConvergenceTest(self._test)
         self.snes = snes
@@ -237,6 +239,8 @@ class NewtonSolver:
         """Free the SNES and its matrix and vectors."""
         self.snes.destroy()
         self.test.destroy()
+        if self.blocks is not None:
+            self.blocks.destroy()
         self.A.destroy()
         self.b.destroy()
         self.x.destroy()
