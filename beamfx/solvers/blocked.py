@@ -25,26 +25,22 @@ class NodeBlockedPC:
     the rigid-body modes of the finite kinematics)."""
 
     def __init__(self, inner, w, perm, bs):
-        from petsc4py import PETSc
-
         self.inner, self.w, self.perm, self.bs = inner, w, perm, bs
-        self.P, self.xp, self.yp = None, None, None
-        comm = w.function_space.mesh.comm
-        self._is = None
-        self._comm = comm
-        self._PETSc = PETSc
+        self.P = self.xp = self.yp = self._is = None
+        self._comm = w.function_space.mesh.comm
 
     def setUp(self, pc):
-        """Permute the operator (reusing the copy's storage after the first time) and set up
-        the inner PC on it."""
-        PETSc = self._PETSc
+        """Permute the operator into node blocks and set up the inner PC on the copy (with
+        the rigid-body modes at the current state, for GAMG)."""
+        from petsc4py import PETSc
+
         _, P = pc.getOperators()
         if self._is is None:
             start = P.getOwnershipRange()[0]
             self._is = PETSc.IS().createGeneral(self.perm + start, comm=self._comm)
             self._is.setBlockSize(self.bs)
-        if self.P is not None:
-            self.P.destroy()
+        if self.P is not None:  # a new copy each time: reusing its storage (MAT_REUSE_MATRIX)
+            self.P.destroy()  # gave wrong values on 2 ranks (CG failed at Newton's 2nd step)
         self.P = P.createSubMatrix(self._is, self._is)
         if self.P.getBlockSize() != self.bs:
             self.P.setBlockSize(self.bs)
@@ -65,10 +61,12 @@ class NodeBlockedPC:
             v = self.P.createVecLeft()
             v.array[:] = q
             vectors.append(v)
-        return self._PETSc.NullSpace().create(vectors=vectors)
+        from petsc4py import PETSc
+
+        return PETSc.NullSpace().create(vectors=vectors)
 
     def apply(self, pc, x, y):
-        """y = P⁻¹ x through the node-ordered copy."""
+        """Apply the inner PC to ``x`` through the node-ordered copy, into ``y``."""
         self.xp.array[:] = x.array_r[self.perm]
         self.inner.apply(self.xp, self.yp)
         y.array[self.perm] = self.yp.array_r

@@ -38,7 +38,7 @@ def beam_node_dofs(W):
     r = R.dofmap.list.array.reshape(-1, nr)
     if len(u) != len(r):
         return None
-    first, rows = np.unique(u[:, 0], return_index=True)
+    _, rows = np.unique(u[:, 0], return_index=True)
     return u[rows], r[rows]
 
 

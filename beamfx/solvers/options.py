@@ -32,7 +32,10 @@ ALLOWED = (
     "ksp_norm_type", "ksp_pc_side", "ksp_initial_guess_nonzero",
     "pc_type", "pc_factor_mat_solver_type", "pc_factor_mat_ordering_type",
     "pc_factor_shift_type", "pc_factor_shift_amount", "pc_factor_levels", "pc_hypre_type",
-    "pc_gamg_type", "pc_gamg_threshold", "pc_asm_overlap", "sub_pc_type", "sub_ksp_type",
+    "pc_hypre_boomeramg_strong_threshold", "pc_hypre_boomeramg_agg_nl",
+    "pc_hypre_boomeramg_relax_type_all", "pc_hypre_boomeramg_coarsen_type",
+    "pc_gamg_type", "pc_gamg_threshold", "pc_gamg_aggressive_coarsening", "mat_coarsen_type",
+    "pc_asm_overlap", "sub_pc_type", "sub_ksp_type",
     "mat_mumps_icntl_<n>", "mat_mumps_cntl_<n>",
     "eps_type", "eps_tol", "eps_max_it", "eps_ncv", "eps_mpd", "st_type",
     "st_ksp_type", "st_pc_type", "st_pc_factor_mat_solver_type",
@@ -47,9 +50,10 @@ _WORD = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
 
 #: ``linear`` in ``[solver]``: the linear solver of every Newton iteration, as a preset of
 #: PETSc options (options given beside it win). ``direct``: LU by MUMPS (the default).
-#: ``iterative``: conjugate gradients preconditioned by smoothed-aggregation algebraic
-#: multigrid (GAMG); for a symmetric tangent (dead loads). Why these, and what they cost:
-#: docs/scenes.md ("[solver]") and docs/validation/frame_scaling.md
+#: ``iterative``: conjugate gradients preconditioned by BoomerAMG (hypre's algebraic
+#: multigrid) on the unknowns ordered node by node (:mod:`beamfx.solvers.blocked`, so it
+#: coarsens each kind of unknown over the nodes); for a symmetric tangent (dead loads). Why
+#: these, and what they cost: docs/scenes.md ("[solver]") and docs/validation/frame_scaling.md
 LINEAR = {
     "direct": {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
     "iterative": {

@@ -1,5 +1,6 @@
 """Run under ``mpirun -n 2``: a lattice frame solved with ``[solver] linear = "iterative"``
-(CG + GAMG) through ``beamfx run`` gives the reactions and probes of one process."""
+(CG + BoomerAMG on node blocks) through ``beamfx run`` gives the reactions and probes of one
+process."""
 
 from pathlib import Path
 
@@ -15,7 +16,7 @@ def test_lattice_iterative_on_all_ranks_matches_one(tmp_path_factory, kinematics
     """A 2³ BCC lattice (118 members, 9 pinned supports): the corner probe and every
     reaction agree to 1e-10 of their size between COMM_WORLD and one process. Both stop
     where Newton's test holds (1e-10 of the load) with CG asked for 1e-12, so their
-    difference is the two Krylov solves' (GAMG's aggregates differ with the partition)."""
+    difference is the two Krylov solves' (the AMG hierarchy differs with the partition)."""
     from beamfx.bench.frame_scaling import lattice_scene
     from beamfx.runner import run_scene
 

@@ -76,7 +76,7 @@ def test_linear_preset_is_validated_and_expanded():
     (key, message), *_ = option_problems({"linear": "gamg"})
     assert key == "linear" and "'direct', 'iterative'" in message
     expanded = expand_linear({"linear": "iterative", "ksp_type": "gmres"})
-    assert expanded["ksp_type"] == "gmres" and expanded["pc_type"] == "gamg"  # given wins
+    assert expanded["ksp_type"] == "gmres" and expanded["pc_type"] == "hypre"  # given wins
     assert "linear" not in expanded and is_iterative(expanded)
     assert not is_iterative(expand_linear({"linear": "direct"}))
     assert expand_linear(None) == {} and set(LINEAR) == {"direct", "iterative"}
@@ -102,7 +102,7 @@ def test_a_scene_with_an_unknown_linear_preset_is_refused():
 
 @pytest.mark.parametrize("kinematics", ["linear", "finite"])
 def test_iterative_and_direct_give_the_same_lattice(tmp_path, kinematics):
-    """A 2³ lattice: CG + GAMG and MUMPS agree on the corner probe and the reactions to
+    """A 2³ lattice: CG + BoomerAMG and MUMPS agree on the corner probe and the reactions to
     1e-10 (the Newton test stops at 1e-10 of the load; CG is asked for 1e-12), and the
     iterative run does no LDLᵀ inertia count."""
     from mpi4py import MPI
