@@ -6,7 +6,8 @@ struts of 1 mm diameter, bottom pinned, 1 N down on every top node) at n³ cells
 (:mod:`beamfx.geometry.lattice`), read through ``[[frames]]`` like a user's scene; one
 element of degree 2 per member. Each size is solved with linear kinematics (6 unknowns per
 node, one load step) and finite kinematics (7 per node: the quaternion; one load step of
-Newton), with ``[solver] linear = "direct"`` (MUMPS) and ``"iterative"`` (CG + GAMG).
+Newton), with ``[solver] linear = "direct"`` (MUMPS) and ``"iterative"`` (CG + BoomerAMG on
+node blocks).
 
 ``python -m beamfx.bench.frame_scaling run DIR [CELLS ...] [--linear direct|iterative]``
 solves on the ranks it is started on and writes ``DIR/frame_scaling_np<N>.json``;
@@ -24,8 +25,9 @@ from .frame_scaling_report import report
 #: cells along an edge -> about 10³, 10⁴, 10⁵ and 10⁶ unknowns (7 per node)
 CELLS = (2, 5, 10, 22)
 #: PETSc events of a Newton iteration (the slowest rank's time): residual and tangent
-#: assembly, preconditioner set-up (MUMPS: the factorisation; GAMG: the hierarchy) and the
-#: linear solve (MUMPS: the triangular solves; CG: the iterations)
+#: assembly, preconditioner set-up (MUMPS: the factorisation; BoomerAMG: the node-ordered
+#: copy and the hierarchy) and the linear solve (MUMPS: the triangular solves; CG: the
+#: iterations)
 EVENTS = {
     "assembly": ("SNESFunctionEval", "SNESJacobianEval"),
     "pc_setup": ("PCSetUp",),
