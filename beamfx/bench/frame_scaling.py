@@ -128,7 +128,9 @@ def _solve(scene, comm):
     seconds["forms"] = time.perf_counter() - t - seconds["model"]
     events = _event_seconds()
     _peak_mib(comm, reset=True)
+    cpu = time.process_time()
     solved = solve_static(model, steps=1, options=scene.solver_options, solver=solver)
+    seconds["cpu_solve"] = time.process_time() - cpu
     peak_solve = _peak_mib(comm)
     after = _event_seconds()
     seconds["solve"] = solved.seconds["total"]
@@ -155,6 +157,7 @@ def measure(folder, cells, kinematics, linear, comm):
     scene = lattice_scene(folder, cells, kinematics, linear, comm)
     read = time.perf_counter() - t0
     model, solver, solved, seconds, split, peak_solve = _solve(scene, comm)
+    cpu = comm.allgather(seconds.pop("cpu_solve"))
     newton = max(solved.newton_iterations, 1)
     split["other"] = max(0.0, seconds["solve"] - sum(split.values()))
     at = scene.probes["corner"]
@@ -174,6 +177,7 @@ def measure(folder, cells, kinematics, linear, comm):
         "seconds": {"scene": read, **seconds},
         "seconds_in_solve": split,
         "per_newton_iteration": {k: v / newton for k, v in split.items()},
+        "cpu_seconds_solve": cpu,  # per rank
         "peak_MiB": _peak_mib(comm),  # the whole case: model, solve, frame
         "peak_MiB_solve": peak_solve,  # the Newton iterations only
         "probe_displacement": [float(v) for v in probe["displacement"]],
