@@ -240,9 +240,24 @@ def _why_lines(runs):
                 f"{b['unknowns']:,} unknowns: the CG iterations grow {its:.2f} times, the cost "
                 f"per unknown and CG iteration {per_it:.1f} times, the memory per unknown "
                 f"(above the libraries' {base:.0f} MiB) {_kib(b, base):.1f} KiB against "
-                f"{_kib(a, base):.1f} KiB. {_iterations_why(its)}"
+                f"{_kib(a, base):.1f} KiB. {_iterations_why(its)}{_cpu_growth(runs, kin)}"
             )
     return lines
+
+
+def _cpu_growth(runs, kin):
+    """The iterative series' CPU µs per unknown and iteration from 10⁴ unknowns up, where
+    recorded (the other jobs on the cores do not inflate it)."""
+    series = sorted((k[0], r) for k, r in runs.items() if k[1:] == (kin, "iterative", 1))
+    cpu = [r for _, r in series if r["unknowns"] >= 5000 and r.get("cpu_seconds_solve")]
+    if len(cpu) < 2:
+        return ""
+    a, b = cpu[0], cpu[-1]
+    return (
+        f" In CPU time: {cpu_us_per_unknown(a):.1f} µs per unknown and iteration at "
+        f"{a['unknowns']:,} unknowns, {cpu_us_per_unknown(b):.1f} at {b['unknowns']:,} "
+        f"({cpu_us_per_unknown(b) / cpu_us_per_unknown(a):.1f} times)."
+    )
 
 
 def _iterations_why(growth):
