@@ -297,7 +297,7 @@ for the linear lattice at 918, 11,286, 83,766 and 857,478 unknowns (1 rank), 293
 Newton iteration and a 15.9 GB peak at the last.
 
 **Noise.** Measured while other agents' jobs shared the 2 cores of this machine (load
-average 6–10): every time is inflated and noisy (±30 % and more; the 2-rank runs suffer
+average 7–13): every time is inflated and noisy (±30 % and more; the 2-rank runs suffer
 most, since their ranks wait for each other), and each size was run once. Ratios between
 neighbouring rows are more trustworthy than the absolute seconds; rerun
 `make bench-frame-scaling` on a quiet machine."""
