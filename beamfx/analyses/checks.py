@@ -45,21 +45,42 @@ def closest_arc_length(curve, x, samples=400):
 
 
 def end_contacts(model, rtol=1e-8):
-    """(i, j, s): the end of beam i lies on beam j at its arc length s (to rtol of the model)."""
+    """(i, j, s): the end of beam i lies on beam j at its arc length s (to rtol of the model).
+
+    The candidate pairs (an end inside the box of another beam) are tested at once: straight
+    beams in closed form with numpy, the others one by one (:func:`closest_arc_length`, which
+    also gives the arc length of every contact inside a span, where a T-joint puts a vertex).
+    """
     tol = rtol * model_size(model)
     lo, hi = _boxes(model, tol)
-    ends = [a.curve.points([0.0, a.curve.length]) for a in model.beams]
-    boxes = _box_search(lo, hi, np.vstack(ends))
-    out = []
-    for i, a in enumerate(model.beams):
-        for e, x in enumerate(ends[i]):
-            near = boxes[2 * i + e]
-            near = near[np.all((lo[near] <= x) & (x <= hi[near]), axis=1)]  # boxes holding x
-            for j in near[near != i]:
-                s, dist = closest_arc_length(model.beams[j].curve, x)
-                if dist < tol:
-                    out.append((i, int(j), s))
-    return out
+    ends = np.vstack([a.curve.points([0.0, a.curve.length]) for a in model.beams])
+    found = _box_search(lo, hi, ends)
+    end = np.repeat(np.arange(len(ends)), [len(f) for f in found])
+    j = np.concatenate(found) if len(found) else np.zeros(0, dtype=np.int64)
+    x = ends[end]
+    keep = (j != end // 2) & np.all((lo[j] <= x) & (x <= hi[j]), axis=1)  # boxes holding x
+    end, j, x = end[keep], j[keep], x[keep]
+    s, dist, length = _closest_on_lines(model, j, x)
+    exact = np.isnan(dist) | ((tol < s) & (s < length - tol))  # not a line, or a T-joint
+    for k in np.flatnonzero(exact):
+        s[k], dist[k] = closest_arc_length(model.beams[j[k]].curve, x[k])
+    hit = dist < tol
+    return list(zip((end[hit] // 2).tolist(), j[hit].tolist(), s[hit].tolist()))
+
+
+def _closest_on_lines(model, j, x):
+    """(s, distance, length of beam j) of the points ``x`` to the straight beams ``j`` (the
+    projection clipped to the segment, vectorised); distance NaN where beam j is not a line."""
+    n = len(model.beams)
+    start, step, length = np.full((n, 3), np.nan), np.zeros((n, 3)), np.ones(n)
+    for b, beam in enumerate(model.beams):
+        if isinstance(beam.curve, Line):
+            start[b], length[b] = beam.curve.start, beam.curve.length
+            step[b] = (np.asarray(beam.curve.end, float) - start[b]) / length[b]
+        else:
+            length[b] = beam.curve.length
+    s = np.clip(np.einsum("ij,ij->i", x - start[j], step[j]), 0.0, length[j])
+    return s, np.linalg.norm(start[j] + s[:, None] * step[j] - x, axis=1), length[j]
 
 
 def _box_search(lo, hi, points):

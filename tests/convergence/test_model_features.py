@@ -6,7 +6,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from beamfx.analyses.checks import check_supported, connected_beams
+from beamfx.analyses.checks import check_supported, connected_beams, end_contacts, joint_breaks
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
 from beamfx.io import evaluate_points
@@ -274,6 +274,8 @@ force = [0, 0, 1e3]
 """
     s = scene(text)
     assert connected_beams(s.model) == [[0, 1]]
+    # b's start lies on a at s = 0.5 (the only contact): found and placed exactly
+    assert end_contacts(s.model) == [(1, 0, 0.5)] and joint_breaks(s.model) == [(0, 0.5)]
     check_supported(s.model)
     # the T-joint is a mesh vertex, so the load on "a" is carried by "b" to its support
     _, v = solve(text, ["a:end", "b:end"])
