@@ -15,10 +15,11 @@ their forms do not depend on how many steps are taken.
 
 What a warm cache covers: the kernels depend on the structure of a scene (kinematics, plane,
 degree, analysis, kinds of loads and supports), not on element counts, lengths or section and
-material values, which enter as coefficient fields. Point-load vectors, spring stiffnesses and
-point masses of the full model enter the forms as numbers, so a scene with other such values
-compiles its residual and tangent again (about 1 to 10 s); the elements and output expressions
-stay cached.
+material values, which enter as coefficient fields, nor on point-load vectors (constants of the
+forms; only whether a force or a moment is zero shapes them). Spring stiffnesses and point
+masses of the full model enter the forms as numbers, so a scene with other such values compiles
+its residual and tangent again (about 1 to 10 s); the elements and output expressions stay
+cached.
 """
 
 import re

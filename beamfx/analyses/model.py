@@ -125,8 +125,19 @@ class BeamModel(Discretised):
         def vec(x):
             return ufl.as_vector([float(c) for c in x])
 
+        def load_vec(x):
+            """A load vector as a ``fem.Constant``: forms of scenes that differ only in load
+            values share one compiled kernel. A zero vector stays UFL's zero, so its terms
+            vanish from the form as before."""
+            from dolfinx import fem
+            from petsc4py import PETSc
+
+            if not any(float(c) for c in x):
+                return vec(x)
+            return fem.Constant(self.mesh.mesh, np.asarray(x, dtype=PETSc.ScalarType))
+
         def work_of(load):
-            force, moment = vec(load.force), vec(load.moment)
+            force, moment = load_vec(load.force), load_vec(load.moment)
             if getattr(load, "axes", "global") == "section":  # components in Λ0's axes
                 force, moment = d.Lam0 * force, d.Lam0 * moment
             return energy.load_work(kin, rot, v_u, v_rot, force, moment, load.kind, load.arm)

@@ -81,6 +81,27 @@ def test_load_steps_and_cutbacks_compile_nothing(jit):
     solver.destroy()
 
 
+def test_another_load_value_is_the_same_form():
+    """Point-load vectors are constants of the forms: scenes that differ only in their load
+    values share the residual's and tangent's signature (the JIT module's name), so a cold
+    cache compiles them once; a moment added where there was none, or another kind of load,
+    is another form."""
+    section = sections.Section(1e6, 1e6, 1e6, 1e3, 1e3, 2e3)
+
+    def signatures(force, moment, follower=False):
+        spec = cantilever(straight(1.0), section, 4, 2, force, moment, follower)
+        model = BeamModel(spec)
+        return model.F.signature(), model.J.signature()
+
+    first = signatures((0, 10.0, 20.0), (0, 0, 0))
+    assert signatures((0, -30.0, 5.0), (0, 0, 0)) == first
+    assert signatures((1.0, 0, 0), (0, 0, 0)) == first
+    with_moment = signatures((0, -30.0, 5.0), (0, -50.0, 0))
+    assert with_moment[0] != first[0] and with_moment[1] != first[1]
+    assert signatures((0, 7.0, 5.0), (0, 3.0, 0)) == with_moment
+    assert signatures((0, 7.0, 5.0), (0, 3.0, 0), follower=True) != with_moment
+
+
 def test_time_steps_and_step_size_changes_compile_nothing(jit, monkeypatch):
     from beamfx.analyses import transient
     from beamfx.analyses.transient import TransientSettings, solve_transient
