@@ -1,5 +1,6 @@
 """Form compilation with the JIT settings every beamfx form needs."""
 
+import os
 import time
 
 JIT_PARAMS = {
@@ -7,6 +8,22 @@ JIT_PARAMS = {
     # instead of the 10 s default (DOLFINx notes, section 9)
     "timeout": 600,
 }
+
+
+def _compile_flags(env=os.environ):
+    """C compiler flags from ``BEAMFX_JIT_CFLAGS`` (e.g. "-O0 -g0" for the test suite, where
+    compiling is most of a cold run and the kernels run briefly), with a cache folder of their
+    own, so that kernels built with other flags are never mixed with the optimised ones
+    (DOLFINx names a module by its form, not by the flags)."""
+    flags = env.get("BEAMFX_JIT_CFLAGS", "").split()
+    if not flags:
+        return {}
+    cache = os.path.join(env.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")), "fenics")
+    tag = "_".join("".join(c for c in f if c.isalnum()) for f in flags)
+    return {"cffi_extra_compile_args": flags, "cache_dir": f"{cache}-{tag}"}
+
+
+JIT_PARAMS.update(_compile_flags())
 
 #: seconds spent in dolfinx.fem.form, summed over the process (cold JIT and cached loads)
 compile_seconds = [0.0]

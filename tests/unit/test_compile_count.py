@@ -221,3 +221,14 @@ def test_an_expression_signature_is_ffcx_own_and_computed_once(monkeypatch):
     )
     dolfinx.fem.Expression(expr, points)  # loaded: the pair of names of one look-up
     assert len(calls) == 1
+
+
+def test_compile_flags_get_a_cache_of_their_own():
+    """BEAMFX_JIT_CFLAGS (the test suite's "-O0 -g0") sets the C flags and a cache folder
+    beside the default one, so kernels built with other flags never serve a user's run."""
+    from beamfx.solvers.forms import _compile_flags
+
+    assert _compile_flags({}) == {}
+    assert _compile_flags({"BEAMFX_JIT_CFLAGS": "  "}) == {}
+    got = _compile_flags({"BEAMFX_JIT_CFLAGS": "-O0 -g0", "XDG_CACHE_HOME": "/c"})
+    assert got == {"cffi_extra_compile_args": ["-O0", "-g0"], "cache_dir": "/c/fenics-O0_g0"}
