@@ -117,11 +117,12 @@ def path_tangent(model, J_form, F_form):
 
 
 def penalty_tangent(model):
-    """Second variation of the quaternion penalty alone (None for the linear kinematics)."""
+    """Second variation of the quaternion penalty alone (None for the linear kinematics), on
+    the model's penalty measure (the one of its residual)."""
     if not model.kin.finite:
         return None
     rot = ufl.split(model.w)[1]
-    Pi = energy.quaternion_penalty(rot, model.k_penalty, model.discretisation.dx)
+    Pi = energy.quaternion_penalty(rot, model.k_penalty, model.penalty_measure())
     v, dw = ufl.TestFunction(model.W), ufl.TrialFunction(model.W)
     return ufl.derivative(ufl.derivative(Pi, model.w, v), model.w, dw)
 

@@ -105,6 +105,11 @@ class BeamFormulation(Formulation, Protocol):
     k_penalty: object
     """``fem.Constant`` of the quaternion unit-norm penalty (part of ``Pi`` for finite
     spatial kinematics)."""
+
+    def penalty_measure(self):
+        """UFL measure on which ``Pi`` integrates the quaternion penalty (the nodes of q by
+        default): every other form of the penalty (the buckling penalty tangent) uses it."""
+
     strains: tuple
     """UFL (Γ, K) of ``w``, section axes (with the members' rotation at released ends), as in
     the strain energy."""

@@ -46,13 +46,12 @@ class BeamModel(Discretised):
     penalty springs.
     """
 
-    #: where the quaternion penalty sees |q|: "quadrature" (the model's ``dx``) or "nodal" (only
-    #: at the nodes of q: :func:`~beamfx.physics.energy.nodal_measure`, which cannot lock)
-    PENALTY_RULES = ("quadrature", "nodal")
-    #: the rule of a model built without ``penalty_rule`` (an internal switch for studies)
-    penalty_rule_default = "quadrature"
+    #: where the quaternion penalty sees |q|: "nodal" (the default: only at the nodes of q,
+    #: :func:`~beamfx.physics.energy.nodal_measure`, which cannot lock) or "quadrature" (the
+    #: model's ``dx``, whose Gauss points hold |q_h| = 1 between the nodes too: it locks)
+    PENALTY_RULES = ("nodal", "quadrature")
 
-    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=(), penalty_rule=None):
+    def __init__(self, model, comm=MPI.COMM_WORLD, extra_points=(), penalty_rule="nodal"):
         from dolfinx import fem
         from petsc4py import PETSc
 
@@ -62,7 +61,6 @@ class BeamModel(Discretised):
         _check_partition(d.mesh.mesh, comm)
         m, p = d.mesh.mesh, d.degree
         self.mixed = model.formulation == "mixed"
-        penalty_rule = penalty_rule or self.penalty_rule_default
         if penalty_rule not in self.PENALTY_RULES:
             raise ValueError(f"penalty_rule {penalty_rule!r}: one of {list(self.PENALTY_RULES)}")
         self.penalty_rule = penalty_rule
@@ -177,7 +175,8 @@ class BeamModel(Discretised):
         return 10 * self.discretisation.stiffness_scale
 
     def penalty_measure(self):
-        """The measure of the quaternion penalty (:attr:`PENALTY_RULES`)."""
+        """The measure of the quaternion penalty (:attr:`PENALTY_RULES`): the residual's, and
+        that of every form that integrates the penalty again (the buckling penalty tangent)."""
         d = self.discretisation
         if self.penalty_rule == "nodal":
             return energy.nodal_measure(d.mesh.mesh, self.W.sub(1).ufl_element())

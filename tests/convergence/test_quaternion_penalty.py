@@ -69,10 +69,11 @@ def test_nodal_penalty_does_not_depend_on_k_p():
     assert moved["quadrature"] > 1e-4, moved
 
 
-def test_default_rule_is_unchanged():
-    """The model's default is still the Gauss rule of ``dx`` (changing it moves bench values);
-    an unknown rule is refused."""
+def test_default_rule_is_nodal():
+    """The model's default is the nodal rule (the Gauss rule of ``dx`` stays on request, for
+    the comparison above); an unknown rule is refused."""
     spec = _bend45(1, 2)
-    assert BeamModel(spec).penalty_rule == "quadrature"
+    assert BeamModel(spec).penalty_rule == "nodal"
+    assert BeamModel(spec, penalty_rule="quadrature").penalty_rule == "quadrature"
     with pytest.raises(ValueError, match="penalty_rule"):
         BeamModel(spec, penalty_rule="gauss")
