@@ -95,12 +95,13 @@ def quaternion_penalty(d):
     """The mixed form's quaternion penalty k_p on the discretisation ``d``: its tangent holds
     no EA or GA, and k_p must not either (the displacement form's is 10·max(EA, GA)). 10 times
     the largest bending or torsion stiffness over the shortest element squared, the size of
-    the bending terms on the rotation unknowns. k_p moves a finite-rotation answer at the
-    discretisation error (it holds |q| = 1 at the quadrature points, between which the
-    rotation is interpolated): the two forms agree to round-off with the same k_p (the
-    model's ``k_penalty`` is a Constant), to the discretisation error with their own; on the
-    45° bend the smaller one is the more accurate (8 × P2 tip error 1.3e-5 with it, 1.1e-3
-    with 10 EA, from a 32 × P4 reference). Collective."""
+    the bending terms on the rotation unknowns. With the penalty at the nodes of q (the
+    model's default ``penalty_rule``) the answer does not depend on k_p beyond the nodal norm
+    drift O(1/k_p). With ``penalty_rule="quadrature"`` it holds |q| = 1 at the Gauss points,
+    between the nodes, and moves the answer at the discretisation error: there the smaller
+    k_p is the more accurate (45° bend, 8 × P2 tip error 1.3e-5 with it, 1.1e-3 with 10 EA,
+    from a 32 × P4 reference). The two forms agree to round-off with the same k_p (the
+    model's ``k_penalty`` is a Constant). Collective."""
     from mpi4py import MPI
 
     bend = d.stiffness.x.array.reshape(-1, 6)[:, 3:]  # diagonals, matrix sections too
