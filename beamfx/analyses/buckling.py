@@ -117,9 +117,10 @@ def path_tangent(model, J_form, F_form):
 
 
 def penalty_tangent(model):
-    """Second variation of the quaternion penalty alone (None for the linear kinematics), on
-    the model's penalty measure (the one of its residual)."""
-    if not model.kin.finite:
+    """Second variation of the quaternion penalty alone (None where the residual has none: the
+    linear kinematics and the planar model, whose rotation is an angle), on the model's
+    penalty measure (the one of its residual)."""
+    if not model.kin.finite or model.kin.plane:
         return None
     rot = ufl.split(model.w)[1]
     Pi = energy.quaternion_penalty(rot, model.k_penalty, model.penalty_measure())
