@@ -63,6 +63,15 @@ ELEMENTS = {
 }
 
 
+def element_name(formulation):
+    """The element column of a beamfx row: :data:`ELEMENTS` of its formulation, with the mixed
+    form said (:func:`.model_choice.formulation` appends " mixed")."""
+    base = formulation.removesuffix(" mixed")
+    if base == formulation:
+        return ELEMENTS[base]
+    return f"{ELEMENTS[base]}, mixed (section force unknowns)"
+
+
 def _cases():
     from . import all_cases
 
@@ -142,7 +151,7 @@ def run_beamfx(out_dir, log=print):
             setting = f"{row['elements']} x P{row['degree']}"
             if "dt" in row:
                 setting += f", dt {row['dt']:g}"
-            element = ELEMENTS[row.get("formulation", "full")]
+            element = element_name(row.get("formulation", "full"))
             if "scheme" in row:  # a line of its own in the plot
                 setting += f", {row['scheme']}"
                 element += f"; {row['scheme']} in time"

@@ -109,3 +109,14 @@ def test_merge_reads_peer_files_without_running_beamfx(tmp_path):
     recs = peers.merge(tmp_path, tmp_path / "out", run=False, log=None)
     assert abs(recs[1]["error"] - 1e-2) < 1e-12
     assert (tmp_path / "out" / "peers.md").exists() and (tmp_path / "out" / "peers_p.png").exists()
+
+
+def test_every_bench_formulation_has_an_element_name():
+    """The peers' element column names each model a bench row can report (the mixed form
+    included), so a model choice never breaks `make bench-peers`."""
+    from beamfx.bench.peers import ELEMENTS, element_name
+
+    for kind in ELEMENTS:
+        assert element_name(kind) == ELEMENTS[kind]
+    assert element_name("full mixed").endswith("mixed (section force unknowns)")
+    assert element_name("planar mixed").startswith(ELEMENTS["planar"])
