@@ -64,11 +64,11 @@ def choose_formulation(spec, analysis, stated="auto", condensed=False):
         )
     if stated != "auto":
         return stated, f"stated: [model] formulation = {stated!r}"
-    ratio = stiffness_ratio(spec)
     if condensed:
         return "displacement", "the condensed model solves it"
     if analysis not in MIXED_ANALYSES:
         return "displacement", f"a {analysis} analysis takes the displacement form only"
+    ratio = stiffness_ratio(spec)
     kin = spec.kinematics
     if not (kin.shear and kin.stretch):
         limits = " and ".join(
