@@ -143,3 +143,21 @@ dt = {dt!r}
 name = "tip"
 at = "beam:end"
 """
+
+
+def run_whole_and_restarted(folder, whole, short):
+    """Run the scene text ``whole`` into ``folder/whole``; run ``short`` (the same scene
+    stopped earlier, with checkpoints) into ``folder/parts`` and restart ``whole`` there.
+    Returns the probes.csv of both (whole, parts) as structured arrays."""
+    from beamfx.runner import run_scene
+
+    quiet = {"log": lambda m: None}
+    (folder / "a.toml").write_text(whole)
+    (folder / "b.toml").write_text(short)
+    run_scene(folder / "a.toml", folder / "whole", **quiet)
+    run_scene(folder / "b.toml", folder / "parts", **quiet)
+    run_scene(folder / "a.toml", folder / "parts", restart=True, **quiet)
+    return tuple(
+        np.genfromtxt(folder / name / "probes.csv", delimiter=",", names=True)
+        for name in ("whole", "parts")
+    )

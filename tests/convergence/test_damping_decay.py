@@ -43,22 +43,13 @@ def test_free_decay_rate_is_a1_omega_over_2():
 def test_restart_with_stiffness_damping_goes_on_exactly(tmp_path):
     """The strains of the last two steps are part of a checkpoint: a damped run stopped at
     t = 0.1 and restarted to 0.2 equals one run to 0.2 (to round-off)."""
-    from scenekit import SPIN_HISTORY, spun_beam
-
-    from beamfx.runner import run_scene
+    from scenekit import SPIN_HISTORY, run_whole_and_restarted, spun_beam
 
     def scene(t_end):
         text = spun_beam(SPIN_HISTORY, t_end, dt=0.01, checkpoint_every=3)
         return text.replace("[analysis]", "[analysis]\ndamping = { stiffness = 0.01 }")
 
-    quiet = {"log": lambda m: None}
-    (tmp_path / "a.toml").write_text(scene(0.2))
-    (tmp_path / "b.toml").write_text(scene(0.1))
-    run_scene(tmp_path / "a.toml", tmp_path / "whole", **quiet)
-    run_scene(tmp_path / "b.toml", tmp_path / "parts", **quiet)
-    run_scene(tmp_path / "a.toml", tmp_path / "parts", restart=True, **quiet)
-    whole = np.genfromtxt(tmp_path / "whole" / "probes.csv", delimiter=",", names=True)
-    parts = np.genfromtxt(tmp_path / "parts" / "probes.csv", delimiter=",", names=True)
+    whole, parts = run_whole_and_restarted(tmp_path, scene(0.2), scene(0.1))
     assert len(parts) == len(whole) and whole["dissipated_damping"][-1] > 0
     for key in ("tip_x", "tip_y", "dissipated_damping"):
         assert np.allclose(parts[key], whole[key], rtol=1e-10, atol=1e-12), key

@@ -118,21 +118,14 @@ def test_spin_up_reaches_the_centrifugal_stretch(tmp_path):
 
 def test_restart_goes_on_where_the_run_stopped(tmp_path):
     """A run stopped at t = 0.04 and restarted to 0.08 equals one run to 0.08."""
-    from beamfx.runner import run_scene
+    from scenekit import run_whole_and_restarted
 
     def scene(t_end):
         return SPIN.replace("t_end = 18.0", f"t_end = {t_end}").replace(
             "dt = 0.0125", "dt = 0.005\ncheckpoint_every = 3\noutput_every = 2"
         )
 
-    quiet = {"log": lambda m: None}
-    (tmp_path / "a.toml").write_text(scene(2.0))
-    (tmp_path / "b.toml").write_text(scene(1.0))
-    run_scene(tmp_path / "a.toml", tmp_path / "whole", **quiet)
-    run_scene(tmp_path / "b.toml", tmp_path / "parts", **quiet)
-    run_scene(tmp_path / "a.toml", tmp_path / "parts", restart=True, **quiet)
-    whole = np.genfromtxt(tmp_path / "whole" / "probes.csv", delimiter=",", names=True)
-    parts = np.genfromtxt(tmp_path / "parts" / "probes.csv", delimiter=",", names=True)
+    whole, parts = run_whole_and_restarted(tmp_path, scene(2.0), scene(1.0))
     assert len(parts) == len(whole)
     assert np.allclose(parts["tip_y"], whole["tip_y"], rtol=0, atol=1e-12)
     results = json.loads((tmp_path / "parts" / "results.json").read_text())
