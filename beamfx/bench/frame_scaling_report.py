@@ -171,21 +171,25 @@ def _cost_lines(runs):
     lines = ["", "## Cost per unknown", ""]
     for kin in ("linear", "finite"):
         for lin in ("direct", "iterative"):
-            series = sorted((k[0], r) for k, r in runs.items() if k[1:] == (kin, lin, 1))
+            series = _series(runs, kin, lin)
             if series:
                 values = ", ".join(
                     f"{r['unknowns']:,}: {us_per_unknown(r):.1f} µs, CPU "
                     f"{cpu_us_per_unknown(r):.1f} µs ({r['krylov_iterations']} Krylov its)"
-                    for _, r in series
+                    for r in series
                 )
                 lines.append(f"* {kin}, {lin}, 1 rank: {values}")
     return lines + _why_lines(runs)
 
 
+def _series(runs, kin, lin):
+    """The 1-rank runs of a series (kinematics, linear solver), by size."""
+    return [r for _, r in sorted((k[0], r) for k, r in runs.items() if k[1:] == (kin, lin, 1))]
+
+
 def _growth(runs, kin, lin):
     """(small, large) 1-rank runs of a series from 10⁴ unknowns up, or None."""
-    series = sorted((k[0], r) for k, r in runs.items() if k[1:] == (kin, lin, 1))
-    series = [r for _, r in series if r["unknowns"] >= 5000]
+    series = [r for r in _series(runs, kin, lin) if r["unknowns"] >= 5000]
     return (series[0], series[-1]) if len(series) > 1 else None
 
 
@@ -248,8 +252,8 @@ def _why_lines(runs):
 def _cpu_growth(runs, kin):
     """The iterative series' CPU µs per unknown and iteration from 10⁴ unknowns up, where
     recorded (the other jobs on the cores do not inflate it)."""
-    series = sorted((k[0], r) for k, r in runs.items() if k[1:] == (kin, "iterative", 1))
-    cpu = [r for _, r in series if r["unknowns"] >= 5000 and r.get("cpu_seconds_solve")]
+    series = _series(runs, kin, "iterative")
+    cpu = [r for r in series if r["unknowns"] >= 5000 and r.get("cpu_seconds_solve")]
     if len(cpu) < 2:
         return ""
     a, b = cpu[0], cpu[-1]
