@@ -206,16 +206,13 @@ def test_restart_cuts_and_continues_the_reaction_series(tmp_path):
     """The spin-up stopped at t = 0.25 s and restarted to 0.5 s: reactions.pvd lists the
     frames of one run to 0.5 s (those after the checkpoint dropped first), each holding what
     the whole run's frame holds (the restart repeats the same steps: to 1e-9)."""
+    from scenekit import run_whole_and_restarted
     from test_transient_reactions import SPIN
 
     short = SPIN.replace("t_end = 1.5", "t_end = 0.25").replace(
         "\noutput_every", "\ncheckpoint_every = 4\noutput_every"
     )
-    (tmp_path / "a.toml").write_text(short.replace("t_end = 0.25", "t_end = 0.5"))
-    (tmp_path / "b.toml").write_text(short)
-    run_scene(tmp_path / "a.toml", tmp_path / "whole", log=_quiet)
-    run_scene(tmp_path / "b.toml", tmp_path / "parts", log=_quiet)
-    run_scene(tmp_path / "a.toml", tmp_path / "parts", restart=True, log=_quiet)
+    run_whole_and_restarted(tmp_path, short.replace("t_end = 0.25", "t_end = 0.5"), short)
     whole, parts = (pvd_frames(tmp_path / n / "reactions.pvd") for n in ("whole", "parts"))
     assert len(whole) == 20 and [f for _, f in parts] == [f for _, f in whole]
     assert np.allclose([t for t, _ in parts], [t for t, _ in whole], rtol=1e-12)
