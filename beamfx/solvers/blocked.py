@@ -13,7 +13,7 @@ have one owner), so it costs a copy of the matrix and two local gathers per appl
 
 import numpy as np
 
-from .nullspace import beam_node_dofs, node_permutation, rigid_modes
+from .nullspace import beam_node_dofs, node_permutation, node_positions, rigid_modes
 
 #: preconditioners that get the node-blocked matrix
 BLOCKED = ("hypre", "gamg")
@@ -26,7 +26,7 @@ class NodeBlockedPC:
 
     def __init__(self, inner, w, perm, bs):
         self.inner, self.w, self.perm, self.bs = inner, w, perm, bs
-        self.P = self.xp = self.yp = self._is = None
+        self.P = self.xp = self.yp = self._is = self._nodes = None
         self._comm = w.function_space.mesh.comm
 
     def setUp(self, pc):
@@ -54,8 +54,10 @@ class NodeBlockedPC:
     def _near_nullspace(self):
         """The six rigid-body modes at the current state, permuted and orthonormalised."""
         W = self.w.function_space
-        u, r = beam_node_dofs(W)
-        modes = rigid_modes(W, u, r, self.w.x.array)[:, self.perm]
+        if self._nodes is None:  # the same at every tangent: found once
+            u, r = beam_node_dofs(W)
+            self._nodes = (u, r, node_positions(W, u))
+        modes = rigid_modes(W, *self._nodes[:2], self.w.x.array, X=self._nodes[2])[:, self.perm]
         vectors = []
         for q in orthonormal(modes, self._comm).T:
             v = self.P.createVecLeft()

@@ -42,16 +42,22 @@ def beam_node_dofs(W):
     return u[rows], r[rows]
 
 
-def rigid_modes(W, u_dofs, r_dofs, x=None):
-    """The six rigid-body motions on the local array of ``W`` (ghosts included), (6, size):
-    translations e_i, then rotations about e_i through the centroid of the nodes. ``x``: the
-    current local array (its displacement and quaternion enter the rotations); None: the
-    reference state (u = 0, q = (1, 0, 0, 0))."""
+def node_positions(W, u_dofs):
+    """The reference positions of the nodes of ``u_dofs`` (rows of :func:`beam_node_dofs`)."""
     V0, collapsed = W.sub(0).collapse()
     first = np.asarray(collapsed)[0::3]  # the W dof of component 0 of each collapsed node
     node = np.empty(_local_size(W), np.int64)
     node[first] = np.arange(len(first))
-    X = V0.tabulate_dof_coordinates()[node[u_dofs[:, 0]]]
+    return V0.tabulate_dof_coordinates()[node[u_dofs[:, 0]]]
+
+
+def rigid_modes(W, u_dofs, r_dofs, x=None, X=None):
+    """The six rigid-body motions on the local array of ``W`` (ghosts included), (6, size):
+    translations e_i, then rotations about e_i through the centroid of the nodes. ``x``: the
+    current local array (its displacement and quaternion enter the rotations); None: the
+    reference state (u = 0, q = (1, 0, 0, 0)). ``X``: the nodes' :func:`node_positions`, if
+    already known."""
+    X = node_positions(W, u_dofs) if X is None else X
     size = len(x) if x is not None else _local_size(W)
     if x is not None:
         X = X + x[u_dofs]
