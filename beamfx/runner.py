@@ -197,10 +197,8 @@ def _context(scene, out, comm, log, restart, pictures):
 
     model = _build(scene, comm, log, scene.condense)
     log(f"model: {_trimming(scene, model, scene.condense)[0]}")
-    log(
-        f"model: {_formulation(scene, model)['name']} formulation "
-        f"({_formulation(scene, model)['reason']})"
-    )
+    formulation = _formulation(scene, model)
+    log(f"model: {formulation['name']} formulation ({formulation['reason']})")
     if scene.condense:
         from .analyses.trimming import condensing_summary
 
