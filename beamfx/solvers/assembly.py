@@ -111,7 +111,7 @@ def assembler(F, J, bcs):
     with the supports ``bcs`` applied to the tangent: the assembly of one Newton iteration."""
     import dolfinx.fem.petsc as fp
 
-    from ..solvers.forms import compile_form
+    from .forms import compile_form
 
     F, J = compile_form(F), compile_form(J)
     b, A = fp.create_vector(F), fp.create_matrix(J)
@@ -120,8 +120,6 @@ def assembler(F, J, bcs):
         with b.localForm() as local:
             local.set(0.0)
         fp.assemble_vector(b, F)
-        A.zeroEntries()
-        fp.assemble_matrix(A, J, bcs=bcs)
-        A.assemble()
+        assemble_tangent(A, J, bcs)
 
     return b, A, assemble
