@@ -57,10 +57,22 @@ def shaft(elements, degree, kind, torque=1.0, section=S27):
     )
 
 
+def as_scene_chooses(spec):
+    """``spec`` with the formulation a buckling scene of it gets (``[model] formulation =
+    "auto"``, :func:`~beamfx.analyses.mixed.choose_formulation`): the displacement form for
+    the shaft as it is (stiffness ratio 4e4), the mixed form from 1e8 (EA, GA × 1e4 in the
+    stress matrix), where the displacement form's roots drift by round-off (2e-3 at × 1e8)."""
+    from dataclasses import replace
+
+    from ..analyses.mixed import choose_formulation
+
+    return replace(spec, formulation=choose_formulation(spec, "buckling")[0])
+
+
 def _torque(n, p):
     ratios, dofs = {}, 0
     for kind in CRITICAL:
-        factors, dofs = _buckling_solve(shaft(n, p, kind))
+        factors, dofs = _buckling_solve(as_scene_chooses(shaft(n, p, kind)))
         ratios[kind] = factors[0] / M_TH_27
     return ratios, dofs, 0
 
@@ -162,5 +174,11 @@ register(
         1e-6,
         SETTINGS,
         note=NOTE,
+        own_model=(
+            "its own solver path (the buckling solve called directly for each kind of the "
+            "torque), not a scene; the model and its formulation are the ones a buckling scene "
+            "gets (full, never trimmed or condensed; the mixed form from a stiffness ratio of "
+            "1e8, as_scene_chooses)"
+        ),
     )
 )
