@@ -39,3 +39,27 @@ def test_imperfect_lattice_tends_to_the_bifurcation(tmp_path):
     expected = lb.extensible_factor(euler)
     assert abs(estimate - expected) / expected < 1e-3
     assert abs(estimate - euler) / euler > 4e-3  # it is not the linear buckling factor
+
+
+def test_stiff_lattice_keeps_the_corner_posts_symmetric(tmp_path):
+    """EA × 1e8 (the stress matrix's last factor; shear-rigid members: the mixed form): the
+    four corner posts, each in two directions, buckle at one load factor by symmetry, and the
+    factor has reached its inextensible limit (it approaches it as 1/EA: 1.6e-3 from × 1 to
+    × 1e2, so ~1.6e-9 from × 1e6 to × 1e8). The redundant axial forces of the posts and struts
+    rest on the compliance 1/EA alone; one solve of the path left them an error ∝ EA (7e-6
+    of the post force at × 1e8), which split the eight factors by 9e-7 and moved the first;
+    the path solve's iterative refinement (buckling.refined_solve) keeps them to round-off."""
+    import numpy as np
+
+    from beamfx.bench import lattice_buckling as lb
+    from beamfx.bench.stress_matrix import stiffened
+
+    folder = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
+    lam = {}
+    for factor in (1e6, 1e8):
+        with stiffened(factor):
+            data = lb.scene_data(2, 2, {"type": "buckling", "modes": 8})
+            lam[factor] = np.array(lb.run(data, f"{folder}/x{factor:g}").result.load_factors)
+    top = lam[1e8]
+    assert len(top) == 8 and np.ptp(top) < 1e-9 * top[0], top
+    assert abs(top[0] - lam[1e6][0]) < 1e-8 * top[0], (top[0], lam[1e6][0])

@@ -173,3 +173,21 @@ def test_real_roots_are_told_from_complex_ones_by_their_residual():
     assert is_real(5181.55 + 4e-5j, 0.0)
     assert not is_real(5000.0 + 10.0j, 1.0)  # an unconverged complex root: capped
     assert not is_real(5000.0 + 5000.0 * 2 * REAL_CAP * 1j, 1.0)
+
+
+def test_the_case_takes_the_mixed_form_where_a_scene_would():
+    """EA and GA ×1e8 (the stress matrix's last factor): the critical torques do not depend on
+    them (no axial or shear force before or in the mode), and the case's own run takes the
+    formulation a buckling scene of the shaft gets (choose_formulation: the mixed form from a
+    stiffness ratio of 1e8). In the displacement form they drifted by round-off ∝ the factor
+    (1.8e-3 for 4 P3 at ×1e8); in the mixed form they keep the ×1 values to the displacement
+    form's round-off there (measured 2e-9 at ×1e2 and 2e-11 at ×1e8)."""
+    from beamfx.bench.stress_matrix import stiffened
+
+    at_1 = smt._torque(4, 3)[0]
+    with stiffened(1e8):
+        spec = smt.as_scene_chooses(smt.shaft(4, 3, "semitangential"))
+        stiff = smt._torque(4, 3)[0]
+    assert spec.formulation == "mixed"
+    for kind, ratio in at_1.items():
+        assert stiff[kind] == pytest.approx(ratio, rel=1e-8), kind
