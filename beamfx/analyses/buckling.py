@@ -71,7 +71,8 @@ def _tangent(A, J_form, bcs, diagonal):
 
 def path_tangent(model, J_form, F_form):
     """dw/dλ at the current state: K dw = −∂F/∂λ, with the rate of the prescribed values on the
-    constrained dofs (both with the load factor unchanged on return)."""
+    constrained dofs (both with the load factor unchanged on return); the solve is refined
+    iteratively (:func:`refined_solve`: the mixed form's redundant forces)."""
     import dolfinx.fem.petsc as fp
     from dolfinx import fem
     from petsc4py import PETSc
