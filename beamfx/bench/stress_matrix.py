@@ -51,6 +51,7 @@ INDEPENDENT = (
     "sm21_shear_rigid",
     "sm210_rotating_inextensible",
     "shallow_arch_bifurcation",
+    "sm27_torque_buckling",
 )
 #: transients and adaptive cases are out of the matrix's scope (issue 16: static, buckling,
 #: modal and rotating)
