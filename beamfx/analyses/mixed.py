@@ -23,11 +23,10 @@ import numpy as np
 
 FORMULATIONS = ("auto", "displacement", "mixed")
 #: the analyses that solve the mixed form (its force block has no mass: the eigen solves by
-#: shift-and-invert take it). Not the rotating one: SLEPc's TOAR on its quadratic problem with
-#: the saddle-point K misses frequencies by 1e-6 to 1e-3 depending on the scaling (NREL 5MW
-#: blade at 0 rpm against the same model's modal analysis; a spurious real mode on SM 2.10's
-#: blade without diagonal scaling); the transient and arc-length runs were not tried
-MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling")
+#: shift-and-invert take it; the rotating one keeps the force unknowns out of its quadratic
+#: eigen solve, :mod:`beamfx.solvers.eigen_shell`); the transient and arc-length runs were
+#: not tried
+MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling", "rotating")
 #: the stiffness ratio from which "auto" chooses the mixed form (module doc)
 RATIO_LIMIT = 1e8
 

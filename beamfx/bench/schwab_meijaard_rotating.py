@@ -113,11 +113,14 @@ def rigid_limit_ratios(n, p, extensible, alphas):
     """Flap and lead-lag ratios ("flap alpha=..." and "lead_lag alpha=..." keys) at each alpha,
     extrapolated to the shear-rigid (and unless ``extensible`` inextensible) limit from
     f = F_STIFF and 2 F_STIFF (:func:`stiff_terms`); also the model, its rotating frame and
-    the Newton iterations."""
+    the Newton iterations. The formulation is the one a scene would get
+    (:func:`~beamfx.analyses.mixed.choose_formulation`: mixed from a stiffness ratio of 1e8)."""
+    from ..analyses.mixed import choose_formulation
     from ..analyses.model import BeamModel
     from ..analyses.rotating import RotatingFrame
 
-    model = BeamModel(blade_model(n, p, F_STIFF, extensible))
+    spec = blade_model(n, p, F_STIFF, extensible)
+    model = BeamModel(replace(spec, formulation=choose_formulation(spec, "rotating")[0]))
     frame = RotatingFrame(model, rotary="none")
     out, its = {}, 0
     for k in (1, 2):

@@ -38,14 +38,16 @@ def test_the_ratio_of_a_rectangle_is_12_slenderness_squared():
         (60.0, Kinematics(), "transient", "displacement"),  # not a mixed analysis
         (2.0, Kinematics(shear=False), "static", "mixed"),  # a penalty model
         (2.0, Kinematics(stretch=False), "linear_static", "mixed"),
-        (2.0, Kinematics(shear=False), "rotating", "displacement"),
+        (2.0, Kinematics(shear=False), "rotating", "mixed"),
+        (2.0, Kinematics(), "rotating", "displacement"),  # ratio 1.2e5
+        (60.0, Kinematics(), "rotating", "mixed"),
         (2.0, Kinematics(shear=False), "arclength", "displacement"),
     ],
 )
 def test_auto_choice(L, kin, analysis, chosen):
     name, why = choose_formulation(_spec(L, kin), analysis)
     assert name == chosen, why
-    if kin.shear and kin.stretch and analysis in ("modal", "buckling"):
+    if kin.shear and kin.stretch and analysis in ("modal", "buckling", "rotating"):
         assert (stiffness_ratio(_spec(L, kin)) >= RATIO_LIMIT) == (name == "mixed")
 
 
