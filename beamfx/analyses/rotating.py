@@ -26,8 +26,8 @@ import ufl
 from ..physics.inertia import point_inertia, spatial_inertia
 from ..physics.kinematics import displacement, spatial_virtual_rotation
 from ..physics.rotating import centrifugal_potential, gyroscopic_covector, relative_position
-from ..solvers.forms import compile_form
 from ..solvers.eigen_shell import solve_quadratic_massless
+from ..solvers.forms import compile_form
 from ..solvers.quadratic import solve_quadratic
 from .dofs import owned_size, subspace_dofs
 from .modal import mass_ufl

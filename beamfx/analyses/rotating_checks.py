@@ -21,7 +21,6 @@ import numpy as np
 
 from ..solvers.snes import SolveFailed
 
-
 #: how many times ε |v|ᵀ|K||v| / |vᴴMv| an eigenvalue's round-off is taken to be. That
 #: estimate alone exceeds the observed error: the Pai strip (8 × P3, at rest) in the
 #: displacement form at EA, GA ×1e4 gives μ 0.038 from the mixed form's 114.8775 (estimate

@@ -58,7 +58,7 @@ class _Shell:
         return self.sol.getArray(readonly=True).copy()
 
     def times(self, A, x, out):
-        """out = A x for a NumPy array ``x`` (local part); returns ``out``."""
+        """A x for a NumPy array ``x`` (local part), into ``out`` (returned)."""
         self.a.array[:] = x
         A.mult(self.a, out)
         return out
