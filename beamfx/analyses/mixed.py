@@ -90,6 +90,18 @@ def force_unknowns(model):
     return global_size(model.W.sub(model.force_index).collapse()[0])
 
 
+def owned_force_dofs(model):
+    """Owned local indices of the section force unknowns (no mass, no gyroscopic terms: the
+    massless unknowns of :mod:`beamfx.solvers.eigen_shell`), or None in the displacement
+    form."""
+    from .dofs import owned_size, subspace_dofs
+
+    if not getattr(model, "mixed", False):
+        return None
+    dofs = subspace_dofs(model.W, model.force_index)
+    return dofs[dofs < owned_size(model.W)]
+
+
 def quaternion_penalty(d):
     """The mixed form's quaternion penalty k_p on the discretisation ``d``: its tangent holds
     no EA or GA, and k_p must not either (the displacement form's is 10·max(EA, GA)). 10 times

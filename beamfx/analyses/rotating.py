@@ -30,6 +30,7 @@ from ..solvers.eigen_shell import solve_quadratic_massless
 from ..solvers.forms import compile_form
 from ..solvers.quadratic import solve_quadratic
 from .dofs import owned_size, subspace_dofs
+from .mixed import owned_force_dofs
 from .modal import mass_ufl
 from .rotating_path import solve_steady  # noqa: F401  (re-exported: its home is rotating_path)
 from .section_fields import offset_inertia
@@ -188,21 +189,12 @@ def assemble_operators(frame):
     return K, G, M
 
 
-def massless_dofs(model):
-    """Owned local indices of the mixed formulation's section force unknowns (no mass, no
-    gyroscopic terms), or None in the displacement form."""
-    if not getattr(model, "mixed", False):
-        return None
-    dofs = subspace_dofs(model.W, model.force_index)
-    return dofs[dofs < owned_size(model.W)]
-
-
 def solve_quadratic_of(model, K, G, M, nev, prefix, options=None):
     """(λ² M + λ G + K) x = 0 nearest 0 for ``model``: SLEPc's TOAR in the displacement
     form; in the mixed form the companion form with the force unknowns kept out of the Krylov
     space (:mod:`beamfx.solvers.eigen_shell`: TOAR misses frequencies there by 1e-6 to 1e-2,
     its Krylov space holding the nearly defective infinite eigenvalues of the forces)."""
-    massless = massless_dofs(model)
+    massless = owned_force_dofs(model)
     if massless is None:
         return solve_quadratic(K, G, M, nev, 0.0, prefix, options)
     return solve_quadratic_massless(K, G, M, nev, prefix, massless, options)

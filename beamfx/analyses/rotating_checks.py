@@ -65,7 +65,7 @@ def lowest_tangent_eigenvalue(frame, prefix="beamfx_rotating_check_"):
 
     from ..solvers.eigen import solve_eigen
     from ..solvers.eigen_shell import solve_eigen_massless
-    from .rotating import massless_dofs
+    from .mixed import owned_force_dofs
 
     K_form, _, M_form = frame.compiled()
     bcs = frame.model.bcs
@@ -73,7 +73,7 @@ def lowest_tangent_eigenvalue(frame, prefix="beamfx_rotating_check_"):
     K.assemble()
     M = fp.assemble_matrix(M_form, bcs=bcs, diagonal=0.0)
     M.assemble()
-    massless = massless_dofs(frame.model)
+    massless = owned_force_dofs(frame.model)
     try:
         if massless is None:
             pairs = solve_eigen(K, M, 1, 0.0, prefix, hermitian=False)
