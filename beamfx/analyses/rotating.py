@@ -192,7 +192,7 @@ def assemble_operators(frame):
 def solve_quadratic_of(model, K, G, M, nev, prefix, options=None):
     """(λ² M + λ G + K) x = 0 nearest 0 for ``model``: SLEPc's TOAR in the displacement
     form; in the mixed form the companion form with the force unknowns kept out of the Krylov
-    space (:mod:`beamfx.solvers.eigen_shell`: TOAR misses frequencies there by 1e-6 to 1e-2,
+    space (:mod:`beamfx.solvers.eigen_shell`: TOAR misses frequencies there by up to 4e-1,
     its Krylov space holding the nearly defective infinite eigenvalues of the forces)."""
     massless = owned_force_dofs(model)
     if massless is None:
