@@ -130,7 +130,8 @@ def _run(op, blocks, nev, prefix, options):
     eps.setProblemType(SLEPc.EPS.ProblemType.NHEP)
     eps.setDimensions(nev=nev)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_MAGNITUDE)
-    with petsc_options(prefix, {**DEFAULT_OPTIONS, "st_type": "shift", **(options or {})}):
+    # the operator is inverted already: no spectral transform, whatever the options say
+    with petsc_options(prefix, {**DEFAULT_OPTIONS, **(options or {}), "st_type": "shift"}):
         eps.setFromOptions()
     n = op.n
 
