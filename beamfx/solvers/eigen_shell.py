@@ -241,8 +241,9 @@ def solve_quadratic_massless(K, G, M, nev, prefix, massless, options=None, scale
     """
     t = time.perf_counter()
     if scale is None:
-        theta = solve_eigen_massless(K, M, max(nev // 2, 1), prefix + "scale_", massless)
-        top = float(np.max(np.abs(theta.values)))
+        k = max(nev // 2, 1)
+        theta = solve_eigen_massless(K, M, k, prefix + "scale_", massless)
+        top = float(np.max(np.abs(theta.values[:k])))  # more may have converged, far ones
         scale = np.sqrt(top) if top > 0 else 1.0
     op = _Companion(K, G, M, float(scale), prefix, massless)
     try:
