@@ -11,8 +11,8 @@ steady state; otherwise the failure is numerical.
 
 Each μ is compared with its round-off, :func:`eigenvalue_floor`: a μ ≤ 0 within it is not
 resolved from 0 (the displacement form at EA, GA ×1e8 gave μ = −4.32 at rest for the Pai
-strip (8 × P3), whose lowest μ there is 114.88 s⁻²), and the fall from rest counts only where it exceeds
-the round-off of both values. The mixed formulation's tangent does not grow with EA, GA, so
+strip, 8 × P3, whose lowest μ there is 114.88 s⁻²), and the fall from rest counts only where
+it exceeds the round-off of both values. The mixed formulation's tangent does not grow with EA, GA, so
 its floor stays small (its force unknowns, without mass, are kept out of the eigen solve:
 :mod:`beamfx.solvers.eigen_shell`).
 """
@@ -24,8 +24,8 @@ from ..solvers.snes import SolveFailed
 #: how many times ε |v|ᵀ|K||v| / |vᴴMv| an eigenvalue's round-off is taken to be. That
 #: estimate alone exceeds the observed error: the Pai strip (8 × P3, at rest) in the
 #: displacement form at EA, GA ×1e4 gives μ 0.038 away from the mixed form's 114.8775
-#: (estimate 6.1), at ×1e8 −4.32 (119 off; estimate 6.2e3); ten times it keeps a margin for the
-#: assembly's sums and the factorisation's growth on other models
+#: (estimate 6.1), at ×1e8 −4.32 (119 off; estimate 6.2e3); ten times it keeps a margin for
+#: the assembly's sums and the factorisation's growth on other models
 ROUNDOFF_FACTOR = 10.0
 
 
