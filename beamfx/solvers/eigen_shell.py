@@ -7,13 +7,13 @@ form's matrix), but K_c⁻¹ v is the displacement part of a solve with the sadd
 K⁻¹ [v; 0]. That solve does not lose the digits that K_c's entries (EA/h, GA/h) cost. The
 force directions themselves are infinite eigenvalues whose chains grow as S → 0 (nearly
 defective: S⁻¹ is the stiffness); a Krylov space that holds them returns eigenvalues with
-small backward errors that are nonetheless wrong. On SM 2.10's blade (8 × P3, shear 1e5·EI/L²,
-at rest, against the mixed model's modal frequencies) SLEPc's TOAR missed by 4e-1 (spurious
-modes), with ``pep_scale both`` by 4e-7 (1e-6 at EA, GA ×1e4), ``pep_type linear`` by 5e-2,
-this module's companion form with the projection below by 1e-12 (without: 2e-2 at Ω = ω_By; STOAR and
-``pep_refine simple`` fail with SLEPc error 56 on this non-Hermitian problem). Zeroing the
-massless unknowns ``massless`` (local indices) of every vector the operator returns (the
-projection P) removes them:
+small backward errors that are nonetheless wrong. On SM 2.10's blade (8 × P3, shear
+1e5·EI/L², at rest, against the mixed model's modal frequencies) SLEPc's TOAR missed by 4e-1
+(spurious modes), with ``pep_scale both`` by 4e-7 (1e-6 at EA, GA ×1e4), ``pep_type linear``
+by 5e-2, this module's companion form with the projection below by 1e-12 (without it: 2e-2
+at Ω = ω_By); STOAR and ``pep_refine simple`` fail with SLEPc error 56 on this non-Hermitian
+problem. Zeroing the massless unknowns ``massless`` (local indices) of every vector the
+operator returns (the projection P) removes them:
 
 * :func:`solve_eigen_massless`: K x = θ M x nearest 0, as P K⁻¹ M P (eigenvalue 1/θ);
 * :func:`solve_quadratic_massless`: (λ² M + λ G + K) x = 0 nearest 0, as the first companion
