@@ -167,7 +167,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         }
         for p, r in zip(result.path, [None] * (len(result.path) - len(reactions)) + reactions)
     ]
-    found = limit_points(result.path)
+    found = located_limits(result, limit_points(result.path))
     limits = [
         {"kind": p.kind, "load_factor": p.load_factor, "displacement": p.displacement}
         for p in found
@@ -203,21 +203,37 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     )
 
 
+def _near(result, limits, c):
+    """Index in ``limits`` of the path's extremum within the step of the critical point
+    ``c`` (or the steps next to it), or None."""
+    s = [p.arc_length for p in result.path]
+    lo, hi = s[max(c.step - 2, 0)], s[min(c.step + 1, len(s) - 1)]
+    return next((i for i, p in enumerate(limits) if lo <= p.arc_length <= hi), None)
+
+
+def located_limits(result, limits):
+    """``limits`` (:func:`~beamfx.analyses.continuation.limit_points`, the path's parabola
+    extrema) with the load factor of the limit point the inertia located in the same step,
+    where there is one (:class:`~beamfx.solvers.arclength.ArcLengthSolver`: the zero of
+    the tangent's eigenvalue, independent of the step sizes)."""
+    out = list(limits)
+    for c in result.critical_points:
+        i = _near(result, limits, c) if c.kind == "limit" and c.load_factor else None
+        if i is not None:
+            out[i] = out[i]._replace(load_factor=c.load_factor)
+    return out
+
+
 def critical_points(result, limits):
     """The critical points of a :class:`~beamfx.analyses.continuation.ContinuationResult` as
-    results.json entries; a limit point gets the load factor of the path's extremum within
-    its step (``limits``: :func:`~beamfx.analyses.continuation.limit_points`)."""
-    s = [p.arc_length for p in result.path]
+    results.json entries; a limit point gets its located load factor, or else that of the
+    path's extremum within its step (``limits``: :func:`located_limits`)."""
     out = []
     for c in result.critical_points:
         lam = c.load_factor
-        if c.kind == "limit":
-            near = [
-                p
-                for p in limits
-                if s[max(c.step - 2, 0)] <= p.arc_length <= s[min(c.step + 1, len(s) - 1)]
-            ]
-            lam = near[0].load_factor if near else None
+        if c.kind == "limit" and lam is None:
+            i = _near(result, limits, c)
+            lam = None if i is None else limits[i].load_factor
         out.append(
             {
                 "kind": c.kind,

@@ -26,8 +26,10 @@ FORMULATIONS = ("auto", "displacement", "mixed")
 #: shift-and-invert take it). Not the rotating one: SLEPc's TOAR on its quadratic problem with
 #: the saddle-point K misses frequencies by 1e-6 to 1e-3 depending on the scaling (NREL 5MW
 #: blade at 0 rpm against the same model's modal analysis; a spurious real mode on SM 2.10's
-#: blade without diagonal scaling); the transient and arc-length runs were not tried
-MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling")
+#: blade without diagonal scaling); the transient runs were not tried. The arc length
+#: measures the kinematic unknowns only and counts the inertia less the force unknowns
+#: (:func:`beamfx.solvers.arclength.inertia_offset`)
+MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling", "arclength")
 #: the stiffness ratio from which "auto" chooses the mixed form (module doc)
 RATIO_LIMIT = 1e8
 

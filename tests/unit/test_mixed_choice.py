@@ -39,7 +39,8 @@ def test_the_ratio_of_a_rectangle_is_12_slenderness_squared():
         (2.0, Kinematics(shear=False), "static", "mixed"),  # a penalty model
         (2.0, Kinematics(stretch=False), "linear_static", "mixed"),
         (2.0, Kinematics(shear=False), "rotating", "displacement"),
-        (2.0, Kinematics(shear=False), "arclength", "displacement"),
+        (2.0, Kinematics(shear=False), "arclength", "mixed"),
+        (2.0, Kinematics(), "arclength", "displacement"),  # ratio 1.2e5
     ],
 )
 def test_auto_choice(L, kin, analysis, chosen):
