@@ -50,7 +50,7 @@ class Settings:
         "moving every displacement dof by 0.4 % of the model's size)",
     )
     min_arc_length: float | None = option(
-        None, positive=True, doc="smallest arc length before failing (default: 1e-4 of the first)"
+        None, positive=True, doc="smallest arc length before failing (default: 1e-8 of the first)"
     )
     branch: str = option(
         "primary",

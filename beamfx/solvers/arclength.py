@@ -90,6 +90,10 @@ class ArcLengthSettings:
         desired_iterations: I_d of the step-size rule Δl_new = Δl (I_d / I)^½.
         max_growth: bound on Δl_new / Δl after a converged step.
         min_arc_length, max_arc_length: bounds on Δl, as multiples of the first arc length.
+            The smallest is far below it: a stiff structure (EA, GA ≫ EI/L²) reaches its
+            first critical point over a displacement ∝ 1/EA (the star dome with EA × 1e6:
+            6e-5 of its scene's first arc length), and the steps before it are halved
+            down to that (their inertia jumps, :data:`INERTIA_JUMP`).
         geometric_arc_length: a Δl the steps may always grow to (units of the measured dofs):
             the default largest Δl is the larger of ``max_arc_length`` first arc lengths and
             this. The first arc length comes from the initial tangent, which a stiff axial or
@@ -116,7 +120,7 @@ class ArcLengthSettings:
     divergence: float = 1e6
     desired_iterations: int = 5
     max_growth: float = 2.0
-    min_arc_length: float = 1e-4
+    min_arc_length: float = 1e-8
     max_arc_length: float = 10.0
     bounds: tuple = (None, None)
     geometric_arc_length: float | None = None
@@ -606,7 +610,9 @@ class ArcLengthSolver:
         except StepTooSmall:
             failure = self._failure(len(path.steps) + 1, path.lam, path.tried)
             details = {"cause": cause, "detail": detail, "load_factor": path.lam}
-            raise SolveFailed(failure, path.steps, cause, arc_remedy(cause), details=details) from None
+            raise SolveFailed(
+                failure, path.steps, cause, arc_remedy(cause), details=details
+            ) from None
 
     def _accept(self, path, saved, taken, state, on_step, log):
         """Record the converged step ``taken`` from the state ``saved``, with ``state`` =
