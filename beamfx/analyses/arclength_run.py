@@ -205,22 +205,40 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
 
 def _near(result, limits, c):
     """Index in ``limits`` of the path's extremum within the step of the critical point
-    ``c`` (or the steps next to it), or None."""
+    ``c`` (or the steps next to it; the nearest to the step), or None."""
     s = [p.arc_length for p in result.path]
     lo, hi = s[max(c.step - 2, 0)], s[min(c.step + 1, len(s) - 1)]
-    return next((i for i, p in enumerate(limits) if lo <= p.arc_length <= hi), None)
+    a, b = s[max(c.step - 1, 0)], s[min(c.step, len(s) - 1)]  # the step itself
+    inside = [i for i, p in enumerate(limits) if lo <= p.arc_length <= hi]
+    return min(
+        inside,
+        key=lambda i: max(a - limits[i].arc_length, limits[i].arc_length - b, 0.0),
+        default=None,
+    )
 
 
 def located_limits(result, limits):
     """``limits`` (:func:`~beamfx.analyses.continuation.limit_points`, the path's parabola
     extrema) with the load factor of the limit point the inertia located in the same step,
     where there is one (:class:`~beamfx.solvers.arclength.ArcLengthSolver`: the zero of
-    the tangent's eigenvalue, independent of the step sizes)."""
-    out = list(limits)
+    the tangent's eigenvalue, independent of the step sizes). Where the inertia is counted,
+    an extremum without a limit point in its steps is left out: the load factor of a smooth
+    path has an extremum only where the tangent is singular (K w' = λ' f = 0), so that one
+    is a zigzag of the steps (a path so steep in the measured displacements, EA × 1e8, that
+    round-off moves λ by more than the step does)."""
+    counted = any(p.negative_eigenvalues is not None for p in result.path[1:])
+    found = {}
     for c in result.critical_points:
-        i = _near(result, limits, c) if c.kind == "limit" and c.load_factor else None
+        i = _near(result, limits, c) if c.kind == "limit" else None
         if i is not None:
-            out[i] = out[i]._replace(load_factor=c.load_factor)
+            found.setdefault(i, c.load_factor)
+    out = []
+    for i, p in enumerate(limits):
+        if i not in found:
+            if not counted:
+                out.append(p)
+            continue
+        out.append(p if found[i] is None else p._replace(load_factor=found[i]))
     return out
 
 
