@@ -67,6 +67,9 @@ from .snes import SolveFailed, constrained_rows
 #: symmetric structure's pair of modes) and a limit point; more says that the corrector
 #: converged onto another branch (:meth:`ArcLengthSolver._jumped`)
 INERTIA_JUMP = 3
+#: a path is trivial in the measured dofs where the load moves them (‖δw_f‖ per unit load
+#: factor) by less than this fraction of the geometric arc length (:meth:`ArcLengthSolver._trivial`)
+TRIVIAL = 1e-12
 #: the bordered system is solved twice per factorisation: a direct solver is the natural fit
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
@@ -234,6 +237,7 @@ class ArcLengthSolver:
         self._rows = constrained_rows(bcs, self.R.getLocalSize())
         self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
+        self._fixed = False  # the step's corrector at a fixed load factor (a trivial path)
         self._cached, self._prepared = None, False
 
         n_owned = (
@@ -349,7 +353,30 @@ class ArcLengthSolver:
         if not isinstance(direction, tuple):
             return direction
         dw, dlam = direction
+        if self._trivial(t):  # Δwᵀδw_f is round-off: the load factor goes on
+            return math.copysign(1.0, dlam)
         return math.copysign(1.0, self._dot(dw, t) + self.settings.psi**2 * dlam * self.ff)
+
+    def _length(self, dw, dlam):
+        """The arc length of the increment (Δw, Δλ): (Δwᵀ S Δw + ψ² Δλ² fᵀf)^½, at least
+        |Δλ| times the trivial floor (a step on a trivial path measures its load factor:
+        :meth:`_predict`, so that a step redone to a part of it goes to that part)."""
+        measured = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        return max(measured, abs(dlam) * self._trivial_floor())
+
+    def _trivial_floor(self):
+        """The measure of δw_f = K⁻¹f below which the path is trivial in the measured dofs:
+        :data:`TRIVIAL` times the geometric arc length (0: none)."""
+        s = self.settings
+        return 0.0 if s.psi else TRIVIAL * (s.geometric_arc_length or 0.0)
+
+    def _trivial(self, t):
+        """Whether the load moves the measured dofs along δw_f = ``t`` by round-off only: a
+        trivial path (the mixed form's inextensible, shear-rigid circular arch under a
+        radial load: u ≡ 0 up to its bifurcation), which the cylindrical constraint cannot
+        measure (its δw_f, round-off amplified near the bifurcation, steers the
+        predictor). Its steps are then taken at a load factor fixed by the predictor."""
+        return math.sqrt(self._dot(t, t)) <= self._trivial_floor()
 
     def _predict(self, lam_n, dl, direction, land_at=None, inject=None):
         """The predictor (Δw_0, Δλ_0) of a step (see :meth:`_step`)."""
@@ -364,6 +391,8 @@ class ArcLengthSolver:
             return dw, land_at - lam_n
         t = self._tangent(lam_n)
         a = math.sqrt(self._dot(t, t) + s.psi**2 * ff)
+        self._fixed = self._trivial(t)  # Δλ = Δl / floor, at that load factor
+        a = max(a, self._trivial_floor())
         if a == 0:
             raise _StepFailed("the load moves no measured dof (δw_f^T S δw_f = 0, ψ = 0)")
         dlam = self._forward(direction, t) * dl / a
@@ -390,7 +419,9 @@ class ArcLengthSolver:
             (Δw, Δλ, iterations, residuals); w and λ hold the new point.
         """
         s = self.settings
+        self._fixed = False
         dw, dlam = self._predict(lam_n, dl, direction, land_at, inject)
+        fixed = land_at is not None or self._fixed
         dw0, dlam0 = dw.copy(), dlam
         self._add(dw)
         self.test.reset()
@@ -407,7 +438,7 @@ class ArcLengthSolver:
                 self._factor(lam_n + dlam)
                 self._solve(self.R, self.dw_R, scale=-1.0)
                 _deflate(self.dw_R, deflate, self.kinematic)
-                if land_at is None:
+                if not fixed:
                     if s.follower:
                         self._load()
                     self._solve(self.f, self.dw_f)
@@ -641,7 +672,7 @@ class ArcLengthSolver:
                 path, saved, taken, point, switch and not path.switched, on_step, log
             ):
                 return True
-        length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        length = self._length(dw, dlam)
         self._record(path, (dw, dlam, its, res), length, count, forward, on_step, log)
         return False
 
@@ -703,7 +734,7 @@ class ArcLengthSolver:
         t = time.perf_counter()
         end, lam_end, cached = self.w.vector.copy(), path.lam + dlam, self._cached
         self._cached = None
-        dl = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        dl = self._length(dw, dlam)
         try:
             x, lam_c, mu, n, phi = self._locate(path, saved, (end, lam_end, dl), point)
         except _StepFailed as e:
@@ -810,7 +841,7 @@ class ArcLengthSolver:
         phi.destroy()
         dw, dlam = taken[:2]
         count, forward = self._at_state(lam_c + dlam, (dw, dlam))
-        length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        length = self._length(dw, dlam)
         self._record(path, taken, length, count, forward, on_step, log, note="branch switch")
         # the secondary branch has its own scale: the step sizes start again from this step's
         path.control = self._control(length)

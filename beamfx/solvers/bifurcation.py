@@ -122,15 +122,17 @@ def smallest_eigenpair(A, solve, x, its=60, rtol=1e-9, metric=None):
         solve(b, y)
         if metric is None:
             y.normalize()
-            y.copy(b)
-        else:
-            weigh(y, b)
-            size = y.dot(b) ** 0.5
+            A.mult(y, r)
+            mu = y.dot(r)
+            r.axpy(-mu, y)
+        else:  # A y = M x: μ = yᵀMx / yᵀMy and the residual M x − μ M y, without yᵀAy
+            # (whose force part cancels: B u = S n holds only to round-off, times n)
+            weigh(y, r)
+            size = y.dot(r) ** 0.5
+            mu = y.dot(b) / size**2
+            r.aypx(-mu, b)  # r = b − μ M y
+            r.scale(1.0 / size)
             y.scale(1.0 / size)
-            b.scale(1.0 / size)
-        A.mult(y, r)
-        mu = y.dot(r)
-        r.axpy(-mu, b)
         y.copy(x)
         if r.norm() <= rtol * scale:
             break
