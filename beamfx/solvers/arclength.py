@@ -67,6 +67,9 @@ from .snes import SolveFailed, constrained_rows
 #: symmetric structure's pair of modes) and a limit point; more says that the corrector
 #: converged onto another branch (:meth:`ArcLengthSolver._jumped`)
 INERTIA_JUMP = 3
+#: how often a step that passed a limit point with another critical point is halved to
+#: separate them
+SEPARATIONS = 4
 #: a path is trivial in the measured dofs where the load moves them (‖δw_f‖ per unit load
 #: factor) by less than this fraction of the geometric arc length (:meth:`ArcLengthSolver._trivial`)
 TRIVIAL = 1e-12
@@ -570,7 +573,7 @@ class ArcLengthSolver:
                 if landed:
                     dw, dlam, its, res = landed
             state = self._at_state(path.lam + dlam, (dw, dlam))
-            if self._jumped(path, saved, state[0], log):
+            if self._jumped(path, saved, state, log):
                 dw.destroy()
                 continue
             if self._accept(path, saved, (dw, dlam, its, res), state, on_step, log):
@@ -611,20 +614,35 @@ class ArcLengthSolver:
             self._reject(path, (dl, why, residuals, detail), cause, log)
             return None
 
-    def _jumped(self, path, saved, count, log):
-        """Whether the converged step changed the inertia by more than :data:`INERTIA_JUMP`
-        (``count`` at its end): the corrector left the path for another branch (a linear
-        predictor far beyond the path's curvature: a stiff initial tangent, whose load
-        increment per arc length is large, and a corrector that converges from far, as the
-        mixed formulation's does). The state is then put back and the arc length halved.
-        Raises SolveFailed when Δl gets too small."""
-        if count is None or path.count is None or abs(count - path.count) <= INERTIA_JUMP:
+    def _jumped(self, path, saved, state, log):
+        """Whether the converged step is to be redone shorter, from its end's ``state`` =
+        (inertia, forward): its inertia changed by more than :data:`INERTIA_JUMP` (the
+        corrector left the path for another branch: a linear predictor far beyond the
+        path's curvature, a stiff initial tangent, whose load increment per arc length is
+        large, and a corrector that converges from far, as the mixed formulation's does),
+        or it passed a limit point and another critical point at once (the limit point is
+        located alone: :meth:`_accept`), up to :data:`SEPARATIONS` times. The state is then
+        put back and the arc length halved. Raises SolveFailed when Δl gets too small."""
+        count, forward = state
+        if count is None or path.count is None or count == path.count:
+            return False
+        change = abs(count - path.count)
+        separate = forward != path.forward and change > 1
+        tries = sum(1 for t in path.tried if t[1].startswith("a limit point"))
+        if change <= INERTIA_JUMP and not (separate and tries < SEPARATIONS):
             return False
         self._restore(saved, path.lam)
         self._cached.destroy()  # δw_f at the rejected state
         self._cached = None
-        why = f"the inertia jumped from {path.count} to {count}: another branch"
-        self._reject(path, (path.control.size, why, (), None), "branch jump", log)
+        if change > INERTIA_JUMP:
+            why, cause = (
+                f"the inertia jumped from {path.count} to {count}: another branch",
+                "branch jump",
+            )
+        else:
+            why = f"a limit point and another critical point (inertia {path.count} -> {count})"
+            cause = "branch jump"
+        self._reject(path, (path.control.size, why, (), None), cause, log)
         return True
 
     def _reject(self, path, tried, cause, log):
