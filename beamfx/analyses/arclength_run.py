@@ -50,7 +50,7 @@ class Settings:
         "moving every displacement dof by 0.4 % of the model's size)",
     )
     min_arc_length: float | None = option(
-        None, positive=True, doc="smallest arc length before failing (default: 1e-4 of the first)"
+        None, positive=True, doc="smallest arc length before failing (default: 1e-8 of the first)"
     )
     branch: str = option(
         "primary",
@@ -167,7 +167,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         }
         for p, r in zip(result.path, [None] * (len(result.path) - len(reactions)) + reactions)
     ]
-    found = limit_points(result.path)
+    found = located_limits(result, limit_points(result.path))
     limits = [
         {"kind": p.kind, "load_factor": p.load_factor, "displacement": p.displacement}
         for p in found
@@ -203,21 +203,55 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     )
 
 
+def _near(result, limits, c):
+    """Index in ``limits`` of the path's extremum within the step of the critical point
+    ``c`` (or the steps next to it; the nearest to the step), or None."""
+    s = [p.arc_length for p in result.path]
+    lo, hi = s[max(c.step - 2, 0)], s[min(c.step + 1, len(s) - 1)]
+    a, b = s[max(c.step - 1, 0)], s[min(c.step, len(s) - 1)]  # the step itself
+    inside = [i for i, p in enumerate(limits) if lo <= p.arc_length <= hi]
+    return min(
+        inside,
+        key=lambda i: max(a - limits[i].arc_length, limits[i].arc_length - b, 0.0),
+        default=None,
+    )
+
+
+def located_limits(result, limits):
+    """``limits`` (:func:`~beamfx.analyses.continuation.limit_points`, the path's parabola
+    extrema) with the load factor of the limit point the inertia located in the same step,
+    where there is one (:class:`~beamfx.solvers.arclength.ArcLengthSolver`: the zero of
+    the tangent's eigenvalue, independent of the step sizes). Where the inertia is counted,
+    an extremum without a limit point in its steps is left out: the load factor of a smooth
+    path has an extremum only where the tangent is singular (K w' = λ' f = 0), so that one
+    is a zigzag of the steps (a path so steep in the measured displacements, EA × 1e8, that
+    round-off moves λ by more than the step does)."""
+    counted = any(p.negative_eigenvalues is not None for p in result.path[1:])
+    found = {}
+    for c in result.critical_points:
+        i = _near(result, limits, c) if c.kind == "limit" else None
+        if i is not None:
+            found.setdefault(i, c.load_factor)
+    out = []
+    for i, p in enumerate(limits):
+        if i not in found:
+            if not counted:
+                out.append(p)
+            continue
+        out.append(p if found[i] is None else p._replace(load_factor=found[i]))
+    return out
+
+
 def critical_points(result, limits):
     """The critical points of a :class:`~beamfx.analyses.continuation.ContinuationResult` as
-    results.json entries; a limit point gets the load factor of the path's extremum within
-    its step (``limits``: :func:`~beamfx.analyses.continuation.limit_points`)."""
-    s = [p.arc_length for p in result.path]
+    results.json entries; a limit point gets its located load factor, or else that of the
+    path's extremum within its step (``limits``: :func:`located_limits`)."""
     out = []
     for c in result.critical_points:
         lam = c.load_factor
-        if c.kind == "limit":
-            near = [
-                p
-                for p in limits
-                if s[max(c.step - 2, 0)] <= p.arc_length <= s[min(c.step + 1, len(s) - 1)]
-            ]
-            lam = near[0].load_factor if near else None
+        if c.kind == "limit" and lam is None:
+            i = _near(result, limits, c)
+            lam = None if i is None else limits[i].load_factor
         out.append(
             {
                 "kind": c.kind,

@@ -2,7 +2,9 @@
 
 The path is parametrised by the load factor λ of ``model.F = F_int(w) - λ F_ext(w)`` and the
 displacement of one named point; the arc length measures the displacement dofs only (the
-``W.sub(0)`` dofs), so that quaternion components do not weigh in.
+``W.sub(0)`` dofs), so that quaternion components do not weigh in, nor the mixed
+formulation's section force (:mod:`beamfx.analyses.mixed`), whose negative pivots the
+inertia count leaves out.
 """
 
 import time
@@ -127,6 +129,7 @@ def trace_path(
         *(model.F, model.J, model.w, model.load_factor, model.bcs, prefix, options, settings),
         norm_dofs=u_dofs,
         sizes=state_sizes(model),
+        force_dofs=force_dofs(model),
     )
     compile_time = compile_seconds[0] - c0
     path, record = _recorder(model, dofs, on_step)
@@ -148,6 +151,16 @@ def trace_path(
     return ContinuationResult(
         tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
     )
+
+
+def force_dofs(model):
+    """Local indices of the mixed formulation's section force unknowns (None in the
+    displacement form): the arc length measures the displacements only, and the inertia and
+    the eigenvector of a critical point are those of the kinematic unknowns
+    (:class:`~beamfx.solvers.arclength.ArcLengthSolver`)."""
+    if not getattr(model, "mixed", False):
+        return None
+    return subspace_dofs(model.W, model.force_index)
 
 
 def _control(spec, control_point, displacement_limit):

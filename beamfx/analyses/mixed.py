@@ -24,9 +24,10 @@ import numpy as np
 FORMULATIONS = ("auto", "displacement", "mixed")
 #: the analyses that solve the mixed form (its force block has no mass: the eigen solves by
 #: shift-and-invert take it; the rotating one keeps the force unknowns out of its quadratic
-#: eigen solve, :mod:`beamfx.solvers.eigen_shell`); the transient and arc-length runs were
-#: not tried
-MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling", "rotating")
+#: eigen solve, :mod:`beamfx.solvers.eigen_shell`); the transient runs were not tried. The
+#: arc length measures the kinematic unknowns only and counts the inertia less the force
+#: unknowns (:func:`beamfx.solvers.arclength.inertia_offset`)
+MIXED_ANALYSES = ("static", "linear_static", "modal", "buckling", "rotating", "arclength")
 #: the stiffness ratio from which "auto" chooses the mixed form (module doc)
 RATIO_LIMIT = 1e8
 

@@ -1,8 +1,9 @@
 """Howcroft et al. (2016) §4.2 without shear and extension flexibility: the antisymmetric
 bifurcation of the shallow pinned arch (``beamfx/scenes/shallow_arch_bifurcation.toml``).
 
-The perfect inextensible arch under a uniform radial load only shortens (by the penalty's
-q R/EA, 1e-5 here) until its tangent has a zero eigenvalue with an antisymmetric null vector:
+The perfect inextensible arch under a uniform radial load keeps its shape (the mixed
+formulation's exact constraints, which "auto" chooses; a penalty would shorten it by q R/EA,
+1e-5) until its tangent has a zero eigenvalue with an antisymmetric null vector:
 the arc-length trace counts the negative eigenvalues (inertia) at every point, locates the
 change by regula falsi on the arc length and switches onto the secondary branch.
 
@@ -43,9 +44,9 @@ def buckling_data(n=None, p=None, q=Q_BELOW):
     data = scene_data("shallow_arch_bifurcation", n, p)
     data["loads"][0]["force_per_length"] = [0.0, -q, 0.0]
     data["model"]["plane"] = "yz"  # the in-plane modes (the 3D arch buckles out of plane first)
-    # the arc-length trace's model (penalty limits; "auto" would take the exact constraints of
-    # the mixed form, 5.7e-6 above the penalty's load at 16 × P3): the same model on both sides
-    data["model"]["formulation"] = "displacement"
+    # the arc-length trace's model: "auto" takes the mixed form for both (exact constraints,
+    # 5.7e-6 above the penalty's load at 16 × P3); stated, so that both sides keep one model
+    data["model"]["formulation"] = "mixed"
     data["analysis"] = {"type": "buckling", "about": "current", "modes": 1, "steps": 5}
     data.pop("probes", None)
     return data

@@ -63,6 +63,16 @@ from .inertia import InertiaCounter, counts_inertia, negative_pivots, prepare
 from .options import petsc_options
 from .snes import SolveFailed, constrained_rows
 
+#: the largest change of the inertia in one accepted step: a double critical point (a
+#: symmetric structure's pair of modes) and a limit point; more says that the corrector
+#: converged onto another branch (:meth:`ArcLengthSolver._jumped`)
+INERTIA_JUMP = 3
+#: how often a step that passed a limit point with another critical point is halved to
+#: separate them
+SEPARATIONS = 4
+#: a path is trivial in the measured dofs where the load moves them (‖δw_f‖ per unit load
+#: factor) by less than this fraction of the geometric arc length (:meth:`ArcLengthSolver._trivial`)
+TRIVIAL = 1e-12
 #: the bordered system is solved twice per factorisation: a direct solver is the natural fit
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
@@ -86,6 +96,10 @@ class ArcLengthSettings:
         desired_iterations: I_d of the step-size rule Δl_new = Δl (I_d / I)^½.
         max_growth: bound on Δl_new / Δl after a converged step.
         min_arc_length, max_arc_length: bounds on Δl, as multiples of the first arc length.
+            The smallest is far below it: a stiff structure (EA, GA ≫ EI/L²) reaches its
+            first critical point over a displacement ∝ 1/EA (the star dome with EA × 1e6:
+            6e-5 of its scene's first arc length), and the steps before it are halved
+            down to that (their inertia jumps, :data:`INERTIA_JUMP`).
         geometric_arc_length: a Δl the steps may always grow to (units of the measured dofs):
             the default largest Δl is the larger of ``max_arc_length`` first arc lengths and
             this. The first arc length comes from the initial tangent, which a stiff axial or
@@ -112,7 +126,7 @@ class ArcLengthSettings:
     divergence: float = 1e6
     desired_iterations: int = 5
     max_growth: float = 2.0
-    min_arc_length: float = 1e-4
+    min_arc_length: float = 1e-8
     max_arc_length: float = 10.0
     bounds: tuple = (None, None)
     geometric_arc_length: float | None = None
@@ -181,6 +195,8 @@ class ArcLengthSolver:
             (the matrix S); None measures all dofs.
         sizes: per owned unknown, the size added to |x| in the round-off floor estimate
             (:meth:`~beamfx.solvers.snes.NewtonSolver.set_sizes`); None: none.
+        force_dofs: local indices of the force unknowns of a saddle-point tangent (the mixed
+            formulation's section force; :func:`inertia_offset`); None: none.
     """
 
     def __init__(
@@ -195,6 +211,7 @@ class ArcLengthSolver:
         settings=None,
         norm_dofs=None,
         sizes=None,
+        force_dofs=None,
     ):
         import dolfinx.fem.petsc as fp
         from petsc4py import PETSc
@@ -223,6 +240,7 @@ class ArcLengthSolver:
         self._rows = constrained_rows(bcs, self.R.getLocalSize())
         self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
+        self._fixed = False  # the step's corrector at a fixed load factor (a trivial path)
         self._cached, self._prepared = None, False
 
         n_owned = (
@@ -233,6 +251,7 @@ class ArcLengthSolver:
         else:
             d = np.asarray(norm_dofs)
             self.norm_dofs = d[d < n_owned]
+        self.kinematic, self.offset = _kinematic(self.comm, n_owned, force_dofs)
 
         ksp = PETSc.KSP().create(self.comm)
         ksp.setOptionsPrefix(prefix)
@@ -337,7 +356,30 @@ class ArcLengthSolver:
         if not isinstance(direction, tuple):
             return direction
         dw, dlam = direction
+        if self._trivial(t):  # Δwᵀδw_f is round-off: the load factor goes on
+            return math.copysign(1.0, dlam)
         return math.copysign(1.0, self._dot(dw, t) + self.settings.psi**2 * dlam * self.ff)
+
+    def _length(self, dw, dlam):
+        """The arc length of the increment (Δw, Δλ): (Δwᵀ S Δw + ψ² Δλ² fᵀf)^½, at least
+        |Δλ| times the trivial floor (a step on a trivial path measures its load factor:
+        :meth:`_predict`, so that a step redone to a part of it goes to that part)."""
+        measured = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        return max(measured, abs(dlam) * self._trivial_floor())
+
+    def _trivial_floor(self):
+        """The measure of δw_f = K⁻¹f below which the path is trivial in the measured dofs:
+        :data:`TRIVIAL` times the geometric arc length (0: none)."""
+        s = self.settings
+        return 0.0 if s.psi else TRIVIAL * (s.geometric_arc_length or 0.0)
+
+    def _trivial(self, t):
+        """Whether the load moves the measured dofs along δw_f = ``t`` by round-off only: a
+        trivial path (the mixed form's inextensible, shear-rigid circular arch under a
+        radial load: u ≡ 0 up to its bifurcation), which the cylindrical constraint cannot
+        measure (its δw_f, round-off amplified near the bifurcation, steers the
+        predictor). Its steps are then taken at a load factor fixed by the predictor."""
+        return math.sqrt(self._dot(t, t)) <= self._trivial_floor()
 
     def _predict(self, lam_n, dl, direction, land_at=None, inject=None):
         """The predictor (Δw_0, Δλ_0) of a step (see :meth:`_step`)."""
@@ -352,6 +394,8 @@ class ArcLengthSolver:
             return dw, land_at - lam_n
         t = self._tangent(lam_n)
         a = math.sqrt(self._dot(t, t) + s.psi**2 * ff)
+        self._fixed = self._trivial(t)  # Δλ = Δl / floor, at that load factor
+        a = max(a, self._trivial_floor())
         if a == 0:
             raise _StepFailed("the load moves no measured dof (δw_f^T S δw_f = 0, ψ = 0)")
         dlam = self._forward(direction, t) * dl / a
@@ -378,7 +422,9 @@ class ArcLengthSolver:
             (Δw, Δλ, iterations, residuals); w and λ hold the new point.
         """
         s = self.settings
+        self._fixed = False
         dw, dlam = self._predict(lam_n, dl, direction, land_at, inject)
+        fixed = land_at is not None or self._fixed
         dw0, dlam0 = dw.copy(), dlam
         self._add(dw)
         self.test.reset()
@@ -394,12 +440,12 @@ class ArcLengthSolver:
             try:
                 self._factor(lam_n + dlam)
                 self._solve(self.R, self.dw_R, scale=-1.0)
-                _deflate(self.dw_R, deflate)
-                if land_at is None:
+                _deflate(self.dw_R, deflate, self.kinematic)
+                if not fixed:
                     if s.follower:
                         self._load()
                     self._solve(self.f, self.dw_f)
-                    _deflate(self.dw_f, deflate)
+                    _deflate(self.dw_f, deflate, self.kinematic)
                     ddlam = self._constraint(dw, dlam, dw0, dlam0, dl)
             except _StepFailed as e:
                 raise _StepFailed(e.args[0], tuple(residuals), "linear solve", e.args[0]) from None
@@ -526,7 +572,11 @@ class ArcLengthSolver:
                 landed = self._land(saved, path.lam, dw, dlam, target_load_factor)
                 if landed:
                     dw, dlam, its, res = landed
-            if self._accept(path, saved, (dw, dlam, its, res), on_step, log):
+            state = self._at_state(path.lam + dlam, (dw, dlam))
+            if self._jumped(path, saved, state, log):
+                dw.destroy()
+                continue
+            if self._accept(path, saved, (dw, dlam, its, res), state, on_step, log):
                 reached = False  # switched onto another branch before the step's end
             if reached:
                 reason = "target"
@@ -555,35 +605,72 @@ class ArcLengthSolver:
     def _attempt(self, path, saved, log):
         """One try of the next step: (Δw, Δλ, iterations, residuals), or None after a failure
         (state restored, Δl halved). Raises SolveFailed when Δl gets too small."""
-        from .step_control import StepTooSmall
-
         dl = path.control.size
         try:
             return self._step(path.lam, dl, path.direction)
         except _StepFailed as e:
             self._restore(saved, path.lam)
             why, residuals, cause, detail = (*e.args, (), None, None)[:4]
-            path.tried.append((dl, why, residuals, detail))
-            if log:
-                n = len(path.steps) + 1
-                log(f"step {n}: arc length {dl:.4g} failed ({why}); halving it")
-            try:
-                path.control.rejected()
-            except StepTooSmall:
-                failure = self._failure(len(path.steps) + 1, path.lam, path.tried)
-                details = {"cause": cause, "detail": detail, "load_factor": path.lam}
-                raise SolveFailed(
-                    failure, path.steps, cause, arc_remedy(cause), details=details
-                ) from None
+            self._reject(path, (dl, why, residuals, detail), cause, log)
             return None
 
-    def _accept(self, path, saved, taken, on_step, log):
-        """Record the converged step ``taken`` from the state ``saved``; its inertia, and the
-        critical point it passed (located, and the branch switched, for a bifurcation).
-        Returns whether the path switched branch (it no longer ends where the step did)."""
+    def _jumped(self, path, saved, state, log):
+        """Whether the converged step is to be redone shorter, from its end's ``state`` =
+        (inertia, forward): its inertia changed by more than :data:`INERTIA_JUMP` (the
+        corrector left the path for another branch: a linear predictor far beyond the
+        path's curvature, a stiff initial tangent, whose load increment per arc length is
+        large, and a corrector that converges from far, as the mixed formulation's does),
+        or it passed a limit point and another critical point at once (the limit point is
+        located alone: :meth:`_accept`), up to :data:`SEPARATIONS` times. The state is then
+        put back and the arc length halved. Raises SolveFailed when Δl gets too small."""
+        count, forward = state
+        if count is None or path.count is None or count == path.count:
+            return False
+        change = abs(count - path.count)
+        separate = forward != path.forward and change > 1
+        tries = sum(1 for t in path.tried if t[1].startswith("a limit point"))
+        if change <= INERTIA_JUMP and not (separate and tries < SEPARATIONS):
+            return False
+        self._restore(saved, path.lam)
+        self._cached.destroy()  # δw_f at the rejected state
+        self._cached = None
+        if change > INERTIA_JUMP:
+            why, cause = (
+                f"the inertia jumped from {path.count} to {count}: another branch",
+                "branch jump",
+            )
+        else:
+            why = f"a limit point and another critical point (inertia {path.count} -> {count})"
+            cause = "branch jump"
+        self._reject(path, (path.control.size, why, (), None), cause, log)
+        return True
+
+    def _reject(self, path, tried, cause, log):
+        """Note the failed attempt ``tried`` = (Δl, why, residuals, detail) and halve Δl;
+        SolveFailed (by ``cause``) when it gets too small."""
+        from .step_control import StepTooSmall
+
+        dl, why, _, detail = tried
+        path.tried.append(tried)
+        if log:
+            log(f"step {len(path.steps) + 1}: arc length {dl:.4g} failed ({why}); halving it")
+        try:
+            path.control.rejected()
+        except StepTooSmall:
+            failure = self._failure(len(path.steps) + 1, path.lam, path.tried)
+            details = {"cause": cause, "detail": detail, "load_factor": path.lam}
+            raise SolveFailed(
+                failure, path.steps, cause, arc_remedy(cause), details=details
+            ) from None
+
+    def _accept(self, path, saved, taken, state, on_step, log):
+        """Record the converged step ``taken`` from the state ``saved``, with ``state`` =
+        (inertia, forward) at its end; the critical point it passed (located, and the branch
+        switched, for a bifurcation). Returns whether the path switched branch (it no longer
+        ends where the step did)."""
         dw, dlam, its, res = taken
         lam = path.lam + dlam
-        count, forward = self._at_state(lam, (dw, dlam))
+        count, forward = state
         kind = classify(path.count, count, path.forward, forward)
         if kind is not None:
             point = CriticalPoint(kind, len(path.steps) + 1, (path.lam, lam), path.count, count)
@@ -592,13 +679,18 @@ class ArcLengthSolver:
                     f"step {point.step}: {kind} point passed between load factors "
                     f"{path.lam:.6g} and {lam:.6g} (negative eigenvalues {path.count} -> {count})"
                 )
-            if kind == "bifurcation":
-                switch = self.settings.branch == "secondary" and not path.switched
-                if self._bifurcation(path, saved, taken, point, switch, on_step, log):
-                    return True
-            else:
+            # located (a limit point too: its load factor to the location's precision, not
+            # to the path's parabola, whose error grows as Δs³ with the steps); a limit
+            # point whose step changed the inertia by more than one passed another point
+            # too, which the location would find instead: left to the parabola
+            switch = kind == "bifurcation" and self.settings.branch == "secondary"
+            if kind == "limit" and abs(count - path.count) != 1:
                 path.critical.append(point)
-        length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+            elif self._bifurcation(
+                path, saved, taken, point, switch and not path.switched, on_step, log
+            ):
+                return True
+        length = self._length(dw, dlam)
         self._record(path, (dw, dlam, its, res), length, count, forward, on_step, log)
         return False
 
@@ -649,23 +741,24 @@ class ArcLengthSolver:
         t = time.perf_counter()
         n = negative_pivots(self.ksp) if self._counter is None else self._counter.count(self.A)
         self.seconds["inertia"] += time.perf_counter() - t
-        return n
+        return n - self.offset  # the force block's own (saddle point: inertia_offset)
 
     def _bifurcation(self, path, saved, taken, point, switch, on_step, log):
-        """Locate the bifurcation the step ``taken`` passed; with ``switch``, record the
-        located point and a first step along the secondary branch and return True; else
-        note the point, put the state back at the step's end and return False."""
+        """Locate the critical point (bifurcation or limit) the step ``taken`` passed; with
+        ``switch``, record the located point and a first step along the secondary branch and
+        return True; else note the point, put the state back at the step's end and return
+        False."""
         dw, dlam = taken[:2]
         t = time.perf_counter()
         end, lam_end, cached = self.w.vector.copy(), path.lam + dlam, self._cached
         self._cached = None
-        dl = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        dl = self._length(dw, dlam)
         try:
             x, lam_c, mu, n, phi = self._locate(path, saved, (end, lam_end, dl), point)
         except _StepFailed as e:
             x = None
             if log:
-                log(f"  the bifurcation could not be located ({e.args[0]})")
+                log(f"  the {point.kind} point could not be located ({e.args[0]})")
         self.seconds["locate"] += time.perf_counter() - t
         if x is not None:
             point = point._replace(load_factor=lam_c, eigenvalue=mu, probes=n)
@@ -673,11 +766,13 @@ class ArcLengthSolver:
             if log:
                 lo, hi = self._bracket
                 log(
-                    f"  bifurcation located at load factor {lam_c:.8g} ({n} solves; the "
-                    f"inertia changes between {lo:.10g} and {hi:.10g})"
+                    f"  {point.kind} point located at load factor {lam_c:.8g} ({n} solves; "
+                    f"the inertia changes between {lo:.10g} and {hi:.10g})"
                 )
         if x is None or not switch:
             path.critical.append(point)
+            if x is not None:
+                phi.destroy()
             self._restore(end, lam_end)
             self._cached = cached
             end.destroy()
@@ -695,9 +790,11 @@ class ArcLengthSolver:
         return True
 
     def _locate(self, path, saved, end, point):
-        """Find the bifurcation within the last step (module :mod:`.bifurcation`): returns
-        (arc length from the step's start, λ, eigenvalue, solves, null vector); w and λ
-        are left at the located point."""
+        """Find the critical point within the last step (module :mod:`.bifurcation`):
+        returns (arc length from the step's start, λ, eigenvalue, solves, null vector); w
+        and λ are left at the located point. The probes of a bifurcation deflate the null
+        vector from their corrections; those of a limit point do not (the path's own
+        tangent is the null vector there)."""
         from mpi4py import MPI
 
         end_vec, lam_end, dl = end
@@ -705,6 +802,8 @@ class ArcLengthSolver:
         rng = np.random.default_rng(self.comm.rank)
         start = rng.standard_normal(phi.getLocalSize())
         start[self._rows] = 0.0  # the constrained dofs' unit eigenvalues are not the structure's
+        if self.kinematic is not None:
+            start *= self.kinematic  # the pencil's metric: kinematic unknowns only
         phi.setArray(start)
         last = {}
 
@@ -716,10 +815,11 @@ class ArcLengthSolver:
                 self._restore(saved, path.lam)
                 lam = path.lam
                 if x:
-                    lam += self._step(path.lam, x, path.direction, deflate=phi)[1]
+                    deflate = phi if point.kind == "bifurcation" else None
+                    lam += self._step(path.lam, x, path.direction, deflate=deflate)[1]
             self._factor(lam)
             count = self._count()
-            mu, _ = smallest_eigenpair(self.A, self._solve, phi)
+            mu, _ = smallest_eigenpair(self.A, self._solve, phi, metric=self.kinematic)
             last.update(lam=lam, mu=mu)
             # the nearest probes on either side: the inertia brackets the point between them
             last["below" if count == point.negative_before else "above"] = lam
@@ -759,7 +859,7 @@ class ArcLengthSolver:
         phi.destroy()
         dw, dlam = taken[:2]
         count, forward = self._at_state(lam_c + dlam, (dw, dlam))
-        length = math.sqrt(self._dot(dw, dw) + self.settings.psi**2 * dlam**2 * self.ff)
+        length = self._length(dw, dlam)
         self._record(path, taken, length, count, forward, on_step, log, note="branch switch")
         # the secondary branch has its own scale: the step sizes start again from this step's
         path.control = self._control(length)
@@ -830,10 +930,50 @@ def _larger_workspace(ksp):
     return 4 * max(F.getMumpsIcntl(14), 20)
 
 
-def _deflate(v, phi):
-    """Remove the φ component of v: v ← v − (φ·v) φ, φ a unit vector (nothing for None)."""
-    if phi is not None:
+def _deflate(v, phi, metric=None):
+    """Remove the φ component of v: v ← v − (φᵀMv) φ, φ a unit vector in the metric M
+    (the weights ``metric``, None: M = I; :func:`~.bifurcation.smallest_eigenpair`);
+    nothing for φ None."""
+    if phi is None:
+        return
+    if metric is None:
         v.axpy(-v.dot(phi), phi)
+        return
+    from mpi4py import MPI
+
+    a = v.getArray(readonly=True) * metric
+    local = float(np.dot(a, phi.getArray(readonly=True)))
+    v.axpy(-v.getComm().tompi4py().allreduce(local, op=MPI.SUM), phi)
+
+
+def _kinematic(comm, n_owned, force_dofs):
+    """(weights 1 on the owned kinematic unknowns and 0 on the force unknowns, or None
+    without force unknowns; their global number :func:`inertia_offset`)."""
+    if force_dofs is None:
+        return None, 0
+    d = np.asarray(force_dofs)
+    d = d[d < n_owned]
+    weights = np.ones(n_owned)
+    weights[d] = 0.0
+    return weights, inertia_offset(comm, len(d))
+
+
+def inertia_offset(comm, owned_forces):
+    r"""The negative eigenvalues the force block adds to the inertia of a saddle-point
+    tangent: its number of force unknowns (``owned_forces`` on this rank, summed).
+
+    The mixed tangent is K = [[A, Bᵀ], [B, −S]] with the compliance S ≥ 0. For S > 0 the
+    congruence K = Lᵀ diag(A + BᵀS⁻¹B, −S) L, L = [[I, 0], [−S⁻¹B, I]], and Sylvester's law
+    of inertia give neg(K) = neg(A + BᵀS⁻¹B) + n_f: the condensed stiffness (the
+    displacement form's tangent with its reduced axial and shear integration) plus one per
+    force unknown. For S = 0 (rigid limits) and B of full rank n_f (the strains at the
+    reduced points are independent), neg(K) = neg(ZᵀAZ) + n_f, Z a basis of ker B (the
+    constrained stiffness); a mixed S with zero and positive entries combines both. So the
+    count less n_f is the inertia the displacement form would report (zero on the
+    constrained rows, whose diagonal is 1)."""
+    from mpi4py import MPI
+
+    return comm.allreduce(int(owned_forces), op=MPI.SUM)
 
 
 #: remedies of a failed arc-length step by cause, where they differ from a load step's
@@ -844,6 +984,7 @@ ARC_REMEDIES = {
     "max iterations": "a smaller max_arc_length ([analysis]), or more iterations",
     "nan": "a smaller max_arc_length; a NaN also comes from a state outside the model's range "
     "(a folded element)",
+    "branch jump": "a smaller first arc length ([analysis] arc_length)",
 }
 
 

@@ -81,37 +81,63 @@ def classify(before, after, forward_before, forward_after):
     return "limit" if forward_before != forward_after else "bifurcation"
 
 
-def smallest_eigenpair(A, solve, x, its=60, rtol=1e-9):
+def smallest_eigenpair(A, solve, x, its=60, rtol=1e-9, metric=None):
     """The eigenvalue of the symmetric ``A`` nearest zero and its vector, by inverse iteration
     x ← A⁻¹x / ‖A⁻¹x‖ with the factorisation in ``solve(rhs, out)``; μ = xᵀAx.
+
+    With ``metric`` (local 0/1 weights m of the owned entries) the pencil A x = μ M x,
+    M = diag(m), instead: x ← A⁻¹Mx / ‖A⁻¹Mx‖_M. For a saddle-point tangent
+    [[K_uu, Bᵀ], [B, −S]] with m = 1 on the kinematic unknowns and 0 on the force unknowns,
+    its finite eigenvalues are those of the condensed stiffness K_uu + BᵀS⁻¹B (of K_uu on
+    ker B where S = 0): the displacement form's μ, not the force block's (other units).
 
     Args:
         A: the assembled matrix (PETSc Mat).
         solve: ``solve(rhs, out)``: out = A⁻¹ rhs with A's factorisation.
-        x: PETSc Vec, the starting vector; holds the unit eigenvector on return.
+        x: PETSc Vec, the starting vector; holds the eigenvector on return (unit in the
+            metric's norm).
         its: at most this many iterations.
-        rtol: stop when ‖Ax − μx‖ ≤ rtol ‖A‖∞.
+        rtol: stop when ‖Ax − μMx‖ ≤ rtol ‖A‖∞.
+        metric: numpy array of the weights m, or None (M = I).
 
     Returns:
         (μ, iterations)
     """
     from petsc4py import PETSc
 
-    y, r = x.duplicate(), x.duplicate()
+    y, r, b = x.duplicate(), x.duplicate(), x.duplicate()
+
+    def weigh(v, out):  # out = M v
+        v.copy(out)
+        if metric is not None:
+            out.setArray(v.getArray(readonly=True) * metric)
+
     scale = A.norm(PETSc.NormType.NORM_INFINITY)
+    weigh(x, b)
+    b.copy(x)
     x.normalize()
     mu = 0.0
     for k in range(1, its + 1):
-        solve(x, y)
-        y.normalize()
-        A.mult(y, r)
-        mu = y.dot(r)
-        r.axpy(-mu, y)
+        weigh(x, b)
+        solve(b, y)
+        if metric is None:
+            y.normalize()
+            A.mult(y, r)
+            mu = y.dot(r)
+            r.axpy(-mu, y)
+        else:  # A y = M x: μ = yᵀMx / yᵀMy and the residual M x − μ M y, without yᵀAy
+            # (whose force part cancels: B u = S n holds only to round-off, times n)
+            weigh(y, r)
+            size = y.dot(r) ** 0.5
+            mu = y.dot(b) / size**2
+            r.aypx(-mu, b)  # r = b − μ M y
+            r.scale(1.0 / size)
+            y.scale(1.0 / size)
         y.copy(x)
         if r.norm() <= rtol * scale:
             break
-    y.destroy()
-    r.destroy()
+    for v in (y, r, b):
+        v.destroy()
     return mu, k
 
 

@@ -88,6 +88,7 @@ def test_stiff_dome_factorises_past_mumps_workspace(tmp_path):
 
     data = star_dome.scene_data(4, 2)
     data["analysis"].update(max_steps=3)
+    data["model"]["formulation"] = "displacement"  # "auto" takes the mixed form (shear-rigid)
     scene = star_dome.scene(data=data)
     with stiffened(1e2):
         run = run_scene(scene.file, tmp_path, log=lambda *a, **k: None, scene=scene)

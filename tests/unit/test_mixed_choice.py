@@ -41,7 +41,8 @@ def test_the_ratio_of_a_rectangle_is_12_slenderness_squared():
         (2.0, Kinematics(shear=False), "rotating", "mixed"),
         (2.0, Kinematics(), "rotating", "displacement"),  # ratio 1.2e5
         (60.0, Kinematics(), "rotating", "mixed"),
-        (2.0, Kinematics(shear=False), "arclength", "displacement"),
+        (2.0, Kinematics(shear=False), "arclength", "mixed"),
+        (2.0, Kinematics(), "arclength", "displacement"),  # ratio 1.2e5
     ],
 )
 def test_auto_choice(L, kin, analysis, chosen):
