@@ -1,13 +1,13 @@
 """A transient analysis of a scene (``[analysis] type = "transient"``), written as it goes.
 
-Every step appends a row to ``probes.csv`` and a line to ``probes.jsonl`` (time, step size,
+Every step adds a row to ``probes.csv`` and a line to ``probes.jsonl`` (time, step size,
 Newton iterations, the probes' position, displacement and unwrapped rotation, and the
-energy balance); frames every ``output_every`` steps (or as ``[output]`` says), and at each
-frame a row of ``reactions.csv`` (:mod:`~beamfx.analyses.transient_reactions`); every
-``checkpoint_every`` steps a checkpoint lets ``beamfx run --restart`` go on from there.
+energy balance), written in blocks (:mod:`~beamfx.analyses.transient_history`); frames every
+``output_every`` steps (or as ``[output]`` says), and at each frame a row of
+``reactions.csv`` (:mod:`~beamfx.analyses.transient_reactions`); every ``checkpoint_every``
+steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
-import json
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -19,20 +19,13 @@ from .formulation import BeamFormulation
 from .registry import Analysis
 from .result import Result as _Base
 from .result import entry
+from .transient_history import History
 
 if TYPE_CHECKING:  # heavy (UFL, PETSc): imported where used
     from ..spec import Model
     from .transient import TransientSettings
 
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
-ENERGY_KEYS = (
-    "kinetic",
-    "strain",
-    "work_loads",
-    "work_supports",
-    "dissipated_damping",
-    "numerical",
-)
 
 
 @dataclass(frozen=True)
@@ -183,92 +176,6 @@ def _jumps(where_key, f, t_end, samples):
         "ramp)"
     )
     return [message]
-
-
-def _columns(probes):
-    cols = ["step", "time", "dt", "iterations", "cutbacks"]
-    for name in probes:
-        cols += [f"{name}_{c}" for c in ("x", "y", "z", "ux", "uy", "uz")]
-        cols += [f"{name}_rot_{c}" for c in ("x", "y", "z")]
-    return cols + list(ENERGY_KEYS)
-
-
-class History:
-    """``probes.csv`` and ``probes.jsonl``: one row per accepted step, appended (rank 0).
-
-    The files stay open for the run, so a step costs one buffered write each, whatever the
-    length of the run; they are flushed at every frame and at the end.
-    """
-
-    def __init__(self, folder, probes, comm, t_restart=None):
-        self.csv, self.jsonl = folder / "probes.csv", folder / "probes.jsonl"
-        self.probes, self.root = probes, comm.rank == 0
-        self.files = None
-        if not self.root:
-            return
-        columns = _columns(probes)
-        header = ",".join(columns)
-        self.row_format = ",".join(["{:.12g}"] * len(columns)) + "\n"
-        if t_restart is None:
-            self.csv.write_text(header + "\n")
-            self.jsonl.write_text("")
-        else:
-            self._truncate(header, t_restart * (1 + 1e-12))
-        self.files = (self.csv.open("a"), self.jsonl.open("a"))
-
-    def _truncate(self, header, t_max):
-        """Keep what was written up to the checkpoint at ``t_max``."""
-        rows = self.csv.read_text().splitlines() if self.csv.exists() else [header]
-        keep = [r for r in rows[1:] if _row_time(r, header.count(",") + 1) <= t_max]
-        self.csv.write_text("\n".join([header, *keep]) + "\n")
-        lines = self.jsonl.read_text().splitlines() if self.jsonl.exists() else []
-        keep = [x for x in lines if _entry_time(x) <= t_max]
-        self.jsonl.write_text("".join(x + "\n" for x in keep))
-
-    def add(self, r, values):
-        """The row of step record ``r`` with the tracked probe ``values``."""
-        if not self.root:
-            return
-        row = [r.step, r.time, r.dt, r.iterations, r.cutbacks]
-        entry = {"step": r.step, "time": r.time, "dt": r.dt, "iterations": r.iterations}
-        entry["probes"] = {}
-        for name, at in self.probes.items():
-            v = values[at]
-            row += [*v["position"], *v["displacement"], *v["rotation_vector_unwrapped"]]
-            keys = ("position", "displacement", "rotation_vector_unwrapped")
-            entry["probes"][name] = {k: v[k] for k in keys}
-        row += [r.energy[k] for k in ENERGY_KEYS]
-        entry["energy"] = r.energy
-        self.files[0].write(self.row_format.format(*row))
-        self.files[1].write(json.dumps(entry) + "\n")
-
-    def flush(self):
-        """Flush the probe files (rank 0)."""
-        for f in self.files or ():
-            f.flush()
-
-    def close(self):
-        """Close the probe files (rank 0)."""
-        for f in self.files or ():
-            f.close()
-        self.files = None
-
-
-def _row_time(row, columns):
-    """The time of a probes.csv row; infinite for a row cut short (a killed run's last)."""
-    cells = row.split(",")
-    try:
-        return float(cells[1]) if len(cells) == columns else np.inf
-    except ValueError:
-        return np.inf
-
-
-def _entry_time(line):
-    """The time of a probes.jsonl line; infinite for a line cut short."""
-    try:
-        return float(json.loads(line)["time"])
-    except (ValueError, KeyError, TypeError):
-        return np.inf
 
 
 def _start(model, settings, ctx):
