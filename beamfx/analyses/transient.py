@@ -141,6 +141,7 @@ class Dynamics:
 
         params = settings.parameters()
         self.h = constant(settings.dt)
+        self._h_storage = self.h.value  # the view Constant.value returns: see set_step
         self.scheme = AlphaStep(params, self.h, params._replace(**{
             k: constant(getattr(params, k)) for k in ("alpha_m", "alpha_f", "beta", "gamma")
         }))  # fmt: skip
@@ -225,6 +226,12 @@ class Dynamics:
             f.x.array[:] = 0.0
         if self.strain_history:
             self.strain_history.start()
+
+    def set_step(self, h):
+        """The step size constant ``h``, written into its storage (what ``self.h.value = h``
+        does, without its copy dispatch) only when it changed: most steps keep the last."""
+        if self._h_storage != h:
+            self._h_storage[...] = h
 
     def predict(self, h):
         """Newton's starting point: the step with unchanged acceleration, and the prescribed
@@ -335,6 +342,9 @@ class EnergyBalance:
         mask = np.zeros(len(m.w.x.array), bool)
         mask[constrained_dofs(m.bcs)] = True
         self.mask = mask[: self.n_owned]  # constrained, owned dofs (as _vector's rows)
+        self._reactions = (np.zeros(self.n_owned), np.zeros(self.n_owned))
+        self._dq, self._mean = np.zeros(self.n_owned), np.zeros(self.n_owned)
+        self.reaction = None
         self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
         self.previous = self.initial = None
         comm = m.comm  # sums over the ranks (none to make on one: a few µs a step saved)
@@ -362,12 +372,14 @@ class EnergyBalance:
             self.reaction = 0.0
             return
         F = self._vector(self.residual) if residual is None else residual
-        self.reaction = F * self.mask
+        # F·mask into the one of two arrays that the previous step's reaction is not
+        out = self._reactions[0] if self._reactions[0] is not self.reaction else self._reactions[1]
+        self.reaction = np.multiply(F, self.mask, out=out)
 
     def record(self, q_old, h):
-        """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0)."""
-        owned = slice(0, self.n_owned)
-        q = self.dyn.w_values[owned].copy()
+        """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0).
+        The works' sums run in arrays made once (the same operations as ``0.5 * (f_n +
+        f_{n+1})·(q - q_old)``, so the same numbers)."""
         now = {
             "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
             "reaction": self.reaction,
@@ -375,11 +387,13 @@ class EnergyBalance:
             "penalty": [[self.scalar(g), float(c.value)] for g, c in self.penalty_motion],
         }
         if self.previous is not None:
-            dq = q - q_old[owned]
-            prev = self.previous
+            n = self.n_owned
+            dq = np.subtract(self.dyn.w_values[:n], q_old[:n], out=self._dq)
+            prev, mean = self.previous, self._mean
 
             def trapezoid(key):
-                return self._sum(float(np.dot(0.5 * (prev[key] + now[key]), dq)))
+                np.add(prev[key], now[key], out=mean)
+                return self._sum(float(np.dot(np.multiply(0.5, mean, out=mean), dq)))
 
             if self.f_loads is not None:
                 self.values["work_loads"] += trapezoid("loads")
@@ -545,7 +559,7 @@ def _newton(m, t, h):
     dyn = m.dyn
     if dyn.extrapolation:
         return dyn.extrapolation.solve(t, h)
-    dyn.h.value = h
+    dyn.set_step(h)
     m.model.set_time(t + h)
     dyn.predict(h)
     return m.solver.solve()
