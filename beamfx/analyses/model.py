@@ -327,7 +327,7 @@ class BeamModel(Discretised):
         factors = {None: 1.0}  # each history evaluated once (a support has one per dof)
         for storage, value, history in self._bc_views:
             if history not in factors:
-                factors[history] = float(history(self.time))
+                factors[history] = _value_at(history, self.time)
             storage[...] = value(lam * factors[history])
 
     def set_time(self, t):
@@ -335,7 +335,7 @@ class BeamModel(Discretised):
         (times the load factor, which a transient keeps at 1)."""
         self.time = t
         for c, history in self._load_histories:
-            c.value = float(history(t))
+            c.value = _value_at(history, t)
         self._set_supports(float(self.load_factor.value))
 
     # --- what solvers and writers ask of every model (CondensedModel answers differently) ---
@@ -367,3 +367,10 @@ class BeamModel(Discretised):
     def unknowns(self):
         """Global number of unknowns."""
         return global_size(self.W)
+
+
+def _value_at(history, t):
+    """``float(history(t))``: through the history's compiled one-value path where it has one
+    (:func:`~beamfx.scene.expr.compile_expression`'s ``at``, the same number)."""
+    at = getattr(history, "at", None)
+    return at(t) if at is not None else float(history(t))

@@ -126,22 +126,41 @@ def compile_expression(text, variable, constants=None):
     tree, nodes = _parse(text)
     for node in nodes:
         _check_node(node, text, allowed)
-    code = compile(tree, "<scene expression>", "eval")
     scope = {"__builtins__": {}, **names, **FUNCTIONS}
+    fn = eval(compile(_as_lambda(tree, variable), "<scene expression>", "eval"), scope)
 
     def f(x):
         x = np.asarray(x, float)
         try:
             with _ignoring_errors(x.ndim):  # non-finite results are the caller's to report
-                y = eval(code, scope, {variable: x})
+                y = fn(x)
         except (OverflowError, ZeroDivisionError) as e:  # float arithmetic of constants
             raise ValueError(f"{_quote(text)}: {e}") from None
         if not x.ndim:  # one value (a history at a time step): the same 0-d array, cheaper
             return np.array(y, dtype=float)
         return np.broadcast_to(y, x.shape).astype(float)
 
-    f.text = text
+    def at(x):
+        """``float(f(x))`` of one number ``x``: the same operations (on a 0-d array)."""
+        try:
+            with _ignoring_errors(0):
+                return float(fn(np.asarray(x, float)))
+        except (OverflowError, ZeroDivisionError) as e:
+            raise ValueError(f"{_quote(text)}: {e}") from None
+
+    f.text, f.at = text, at
     return f
+
+
+def _as_lambda(tree, variable):
+    """The checked expression ``tree`` as the syntax tree of ``lambda variable: tree``:
+    compiled once into a function, whose variable is a local and whose names are the scope's
+    (the same operations as evaluating the tree with the variable bound, a few microseconds
+    less per call: a history is evaluated at every time step)."""
+    args = ast.arguments(
+        posonlyargs=[], args=[ast.arg(arg=variable)], kwonlyargs=[], kw_defaults=[], defaults=[]
+    )
+    return ast.fix_missing_locations(ast.Expression(body=ast.Lambda(args=args, body=tree.body)))
 
 
 def table_function(xs, values):
