@@ -123,7 +123,8 @@ class History:
             numbers += (step, t, dt, iterations, cutbacks, *flat)
             numbers += [energy[k] for k in ENERGY_KEYS]
             spent = list(energy.values())
-            if all(type(e) is float for e in spent) and math.isfinite(sum(flat) + sum(spent)):
+            plain = all(type(e) is float for e in spent)  # (a sum overflowing: the json path)
+            if plain and math.isfinite(t + dt + sum(flat) + sum(spent)):
                 keys = tuple(energy)
                 if keys not in self.formats:
                     self.formats[keys] = _line_format(self.probes, keys)
