@@ -237,11 +237,9 @@ class Dynamics:
         """Newton's starting point: the step with unchanged acceleration, and the prescribed
         values of the supports at t_{n+1} (a mismatch there would start Newton from a state
         with a sudden strain at the support)."""
-        from dolfinx.cpp.fem import set_bc
-
         q_n, v_n, a_n, _ = self.state_values
         self.w_values[:] = self.scheme.predict(q_n, v_n, a_n, h)
-        set_bc(self.w_values, self.model.bcs, None, 1.0)  # fem.set_bc's call, without its wrapper
+        _set_bc(self.w_values, self.model.bcs, None, 1.0)  # fem.set_bc's call, no wrapper
 
     def accept(self, h):
         """Move the converged q_{n+1} (in the model's unknowns) into the state at t_n."""
@@ -298,6 +296,15 @@ class Dynamics:
         self.model.w.x.array[:] = self.q_n.x.array
         if self.strain_history:
             self.strain_history.set_state(arrays)
+
+
+def _set_bc(*args):
+    """``dolfinx.cpp.fem.set_bc(*args)`` (the same call), its import made once."""
+    from dolfinx.cpp.fem import set_bc
+
+    global _set_bc
+    _set_bc = set_bc
+    return set_bc(*args)
 
 
 def _assemble_scalar(form):

@@ -85,7 +85,7 @@ def _kinematics(model, names, recover):
     out = {}
     for i, (n, node) in enumerate(rows):
         v = values[i, node]
-        out[n] = _kinematic_values(finite, v[X], v[u], v[rot])
+        out[n] = _kinematic_values(finite, v.tolist(), (X, u, rot), v[rot])
     return out
 
 
@@ -107,14 +107,19 @@ def _point_values(finite, v):
     return out
 
 
-def _kinematic_values(finite, X, u, rot):
+def _kinematic_values(finite, row, parts, rot):
     """``position``, ``displacement`` and the rotation (``quaternion`` of finite kinematics,
-    else ``rotation_vector``) of one point: :func:`_point_values` without the rest."""
-    out = {"position": (X + u).tolist(), "displacement": u.tolist()}
+    else ``rotation_vector``) of one point: :func:`_point_values` without the rest. ``row``:
+    the point's quantities as a list, ``parts`` the slices of X, u and the rotation in it,
+    ``rot`` the rotation's array. In plain floats (the same IEEE sums and quotients as the
+    arrays'), the norm through the array's ``dot`` (:func:`numpy.linalg.norm`'s, bitwise)."""
+    X, u, r = (row[p] for p in parts)
+    out = {"position": [a + b for a, b in zip(X, u)], "displacement": u}
     if finite:
-        out["quaternion"] = (rot / math.sqrt(rot.dot(rot))).tolist()  # np.linalg.norm, bitwise
+        norm = math.sqrt(rot.dot(rot))
+        out["quaternion"] = [c / norm for c in r]
     else:
-        out["rotation_vector"] = rot.tolist()
+        out["rotation_vector"] = r
     return out
 
 
