@@ -27,7 +27,8 @@ no residual of its own: no reactions are reported for it.
 
 **When.** The reactions cost two vector assemblies (inertia and loads) and a few reductions, so
 they are taken at the output steps only (the ParaView frames: ``output_every``, ``[output]
-every``/``times``) and at the last step; each is a row of ``reactions.csv`` appended as the run
+every``/``times``) and at the last step, or at every step if ``[output] reaction_rows =
+"steps"`` asks; each is a row of ``reactions.csv`` appended as the run
 goes (rank 0; the writer a static run uses too, :mod:`beamfx.io.reaction_files`), a frame of
 ``reactions.pvd`` beside the other frames of the step, and ``results.json`` keeps the last one
 and the largest values over the run.

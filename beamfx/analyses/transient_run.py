@@ -3,8 +3,9 @@
 Every step adds a row to ``probes.csv`` and a line to ``probes.jsonl`` (time, step size,
 Newton iterations, the probes' position, displacement and unwrapped rotation, and the
 energy balance), written in blocks (:mod:`~beamfx.analyses.transient_history`); frames every
-``output_every`` steps (or as ``[output]`` says), and at each frame a row of
-``reactions.csv`` (:mod:`~beamfx.analyses.transient_reactions`); every ``checkpoint_every``
+``output_every`` steps (or as ``[output]`` says), and at each frame (every step with
+``[output] reaction_rows = "steps"``) a row of ``reactions.csv``
+(:mod:`~beamfx.analyses.transient_reactions`); every ``checkpoint_every``
 steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
@@ -197,6 +198,15 @@ def _start(model, settings, ctx):
     return saved
 
 
+def _reaction_steps(ctx):
+    """``want(step, time, last)`` of the rows of reactions.csv: the frames' (default), or
+    every step with ``[output] reaction_rows = "steps"``."""
+    settings = getattr(ctx.frames, "settings", None)
+    if getattr(settings, "reaction_rows", "frames") == "steps":
+        return lambda step, time, last=False: True
+    return ctx.frames.want
+
+
 def _progress(comm, t_end):
     from ..io import Progress
 
@@ -228,7 +238,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     saved = _start(model, settings, ctx)
     t_restart = saved[0]["t"] if saved else None
     history = History(ctx.folder, ctx.probes, ctx.comm, t_restart)
-    series = ReactionSeries(ctx.folder, ctx.comm, ctx.frames.want, t_restart)
+    series = ReactionSeries(ctx.folder, ctx.comm, _reaction_steps(ctx), t_restart)
     energy = {}
 
     def on_step(r):

@@ -59,6 +59,13 @@ class OutputSettings:
     fields: tuple[str, ...] = option(
         POINT_ARRAYS, choices=POINT_ARRAYS, doc="point arrays written in the frames"
     )
+    reaction_rows: str = option(
+        "frames",
+        choices=("frames", "steps"),
+        doc="rows of a transient's reactions.csv: at the frame steps (and the last), or at "
+        "every time step (`steps`: two vector assemblies more per step); the ParaView "
+        "reactions stay at the frames",
+    )
     formats: tuple[str, ...] = option(
         VTK_FORMATS,
         choices=FORMATS,

@@ -11,6 +11,7 @@ a few ε of the largest force.
 
 import csv
 import json
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
@@ -163,6 +164,30 @@ def test_spin_up_hub_torque_balances_the_inertia_and_does_the_work(tmp_path):
     assert work > 0
     assert work == pytest.approx(run["energy"]["work_supports"], rel=3e-3)
     assert np.allclose(vec(data, "inertia_m_")[:, 2], data["beam:start_mz"], rtol=1e-8)
+
+
+def test_reaction_rows_at_every_step_when_asked(tmp_path):
+    """``[output] reaction_rows = "steps"``: a row of reactions.csv at every time step, those
+    of the frame steps the default run's rows to the last digit; the ParaView reactions stay
+    at the frames."""
+    short = SPIN.replace("output_every = 2", "output_every = 4").replace(
+        "t_end = 1.5", "t_end = 0.5"
+    )
+    (tmp_path / "frames.toml").write_text(short)
+    (tmp_path / "steps.toml").write_text(short + '\n[output]\nreaction_rows = "steps"\n')
+    for name in ("frames", "steps"):
+        run_scene(tmp_path / f"{name}.toml", tmp_path / name, log=lambda m: None)
+    lines = {
+        n: (tmp_path / n / "reactions.csv").read_text().splitlines() for n in ("frames", "steps")
+    }
+    assert len(lines["frames"]) == 1 + 10 and len(lines["steps"]) == 1 + 40
+    assert lines["steps"][0] == lines["frames"][0]
+    assert lines["steps"][4::4] == lines["frames"][1:]  # steps 4, 8, ..., 40
+    for name in ("frames", "steps"):
+        root = ET.parse(tmp_path / name / "reactions.pvd").getroot()
+        assert [d.get("file") for d in root.iter("DataSet")] == [
+            f"reactions_{k:04d}.vtu" for k in range(4, 41, 4)
+        ]
 
 
 def test_restart_cuts_and_continues_the_series(tmp_path):
