@@ -27,6 +27,7 @@ from ..physics import coupled, energy
 from ..physics.coupled import as_matrix6
 from ..physics.kinematics import section_frame, tangent
 from ..spec import resolve_point
+from ..spec.model import beam_index
 from .checks import joint_breaks
 from .section_fields import SectionMatrices, dg_points, is_coupled, matrix_fields
 
@@ -77,6 +78,16 @@ def cell_function(mesh, values):
     return cell_field(mesh, 0, values[:, None])
 
 
+def beam_cells(cell_beam, n_beams):
+    """(i, local cells of beam i in ascending order) for every beam i that has local cells:
+    one sort instead of a comparison of all cells per beam (O(N²) on a frame of 10⁵ members).
+    Beams without local cells are left out."""
+    cell_beam = np.asarray(cell_beam)
+    order = np.argsort(cell_beam, kind="stable")
+    bounds = np.searchsorted(cell_beam[order], np.arange(n_beams + 1))
+    return [(i, order[bounds[i] : bounds[i + 1]]) for i in np.flatnonzero(np.diff(bounds)).tolist()]
+
+
 def cell_arc_lengths(spec, mesh, X):
     """Arc length of the reference points ``X`` (in [0, 1]) of each local cell of ``mesh`` (a
     :class:`~beamfx.geometry.BeamMesh` of the beams of ``spec``): (n_cells, len(X))."""
@@ -85,9 +96,9 @@ def cell_arc_lengths(spec, mesh, X):
     nodes = m.geometry.dofmap.array.reshape(-1, mesh.degree + 1)[:n]
     x0 = m.geometry.x[nodes[:, 0]]
     flipped = np.zeros(n, bool)  # DOLFINx may reverse a cell: its vertex 0 is then at s_b
-    for i, b in enumerate(spec.beams):
-        sel = mesh.cell_beam == i
-        if np.any(sel):
+    for i, sel in beam_cells(mesh.cell_beam[:n], len(spec.beams)):
+        b = spec.beams[i]
+        if len(sel):
             at_a = np.linalg.norm(x0[sel] - b.curve.points(spans[sel, 0]), axis=1)
             at_b = np.linalg.norm(x0[sel] - b.curve.points(spans[sel, 1]), axis=1)
             flipped[sel] = at_b < at_a
@@ -107,26 +118,39 @@ def _section_fields(spec, mesh, comm):
     S = cell_arc_lengths(spec, mesh, X)
     stiff = np.zeros((len(cb), len(X), 6))
     mass = np.zeros((len(cb), len(X), 4))
-    raw_max = 0.0
+    raw_max, rows = 0.0, _section_rows(kin)
+    local = dict(beam_cells(cb, len(beams)))
     for i, b in enumerate(beams):
-        sel = cb == i
-        samples = b.section.along(S[sel].ravel()) if np.any(sel) else b.section.along([0.0])
-        raw_max = max(raw_max, max(max(x.EA, x.GA_y, x.GA_z) for x in samples))
-        limited = {}
-        for x in samples:
-            if id(x) not in limited:
-                limited[id(x)] = x.with_limits(not kin.shear, not kin.stretch, b.curve.length)
-        stiff[sel] = np.array([limited[id(x)].stiffnesses() for x in samples]).reshape(
-            -1, len(X), 6
-        )[: np.count_nonzero(sel)]
-        mass[sel] = np.array([x.inertias() for x in samples]).reshape(-1, len(X), 4)[
-            : np.count_nonzero(sel)
-        ]
+        sel = local.get(i)
+        samples = b.section.along(S[sel].ravel() if sel is not None else [0.0])
+        distinct = {id(x): x for x in samples}.values()
+        raw_max = max(raw_max, max(max(x.EA, x.GA_y, x.GA_z) for x in distinct))
+        if sel is None:
+            continue
+        k, m = zip(*(rows(x, b.curve.length) for x in samples))
+        stiff[sel] = np.array(k).reshape(-1, len(X), 6)[: len(sel)]
+        mass[sel] = np.array(m).reshape(-1, len(X), 4)[: len(sel)]
     if np.any(stiff <= 0):
         raise ValueError("a section stiffness is not positive somewhere along a beam")
     raw_max = comm.allreduce(raw_max, op=MPI.MAX)
     m = mesh.mesh
     return cell_field(m, q, stiff), cell_field(m, q, mass), raw_max
+
+
+def _section_rows(kin):
+    """``rows(section, length)``: the section's stiffnesses with the limits of ``kin`` (for a
+    beam of that length) and its inertias, computed once per section and length (a frame's
+    members share a few section objects; each section is kept, so its id is not reused)."""
+    known = {}
+
+    def rows(x, length):
+        key = (id(x), length)
+        if key not in known:
+            limited = x.with_limits(not kin.shear, not kin.stretch, length)
+            known[key] = (x, limited.stiffnesses(), x.inertias())
+        return known[key][1:]
+
+    return rows
 
 
 def _twist_field(spec, mesh):
@@ -144,8 +168,8 @@ def along_beams(spec, mesh, per_beam):
     or a vectorised function of the arc length s along beam i) on the cells of beam i."""
     S = cell_arc_lengths(spec, mesh, dg_points(mesh.degree))
     values = np.zeros_like(S)
-    for i, t in enumerate(per_beam):
-        sel = mesh.cell_beam == i
+    for i, sel in beam_cells(mesh.cell_beam[: len(S)], len(per_beam)):
+        t = per_beam[i]
         values[sel] = np.asarray(t(S[sel]), float) if callable(t) else t
     return values
 
@@ -162,7 +186,8 @@ def _beam_mesh(spec, comm, degree, extra_points):
     """Named points (every 'at' of supports, loads, springs, masses and ``extra_points``) as
     {at: (beam, s, xyz)} and the mesh with a vertex at each of them and at T-joints."""
     ats = [x.at for x in (*spec.supports, *spec.point_loads, *spec.springs, *spec.point_masses)]
-    named = {at: resolve_point(spec, at) for at in dict.fromkeys(ats + list(extra_points))}
+    index = beam_index(spec)
+    named = {at: resolve_point(spec, at, index) for at in dict.fromkeys(ats + list(extra_points))}
     breaks = {i: [] for i in range(len(spec.beams))}
     for b, s, _ in named.values():
         breaks[b].append(s)
@@ -208,9 +233,9 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
     else:
         stiffness, inertia, raw_max = _section_fields(spec, mesh, comm)
     ref = default_reference(_cell_tangents(mesh))
-    for i, b in enumerate(spec.beams):
-        if b.orientation is not None:
-            ref[cb == i] = b.orientation
+    for i, sel in beam_cells(cb[: len(ref)], len(spec.beams)):
+        if spec.beams[i].orientation is not None:
+            ref[sel] = spec.beams[i].orientation
     reference = cell_function(m, ref)
     twist = _twist_field(spec, mesh)
     t0 = tangent(m)

@@ -39,8 +39,14 @@ def stiffness_ratio(spec, samples=5):
     from ..physics.matrix_sections import section_matrices, with_limits
 
     kin, worst = spec.kinematics, 0.0
+    # once per section and length: a frame's members share a few sections (the section is
+    # kept in the key's value, so its id is not reused)
+    done = {}
     for b in spec.beams:
         L = b.curve.length
+        if (id(b.section), L) in done:
+            continue
+        done[id(b.section), L] = b.section
         C, _ = section_matrices(b.section, np.linspace(0.0, L, samples))
         C = with_limits(C, not kin.shear, not kin.stretch, L)
         diag = np.diagonal(C, axis1=1, axis2=2)

@@ -248,7 +248,7 @@ class BeamModel(Discretised):
         from petsc4py import PETSc
 
         m = self.mesh.mesh
-        bcs, values = [], []
+        bcs, values, spaces = [], [], {}
         for sup in self.spec.supports:
             if sup.axes == "local":
                 continue  # penalty springs in the forms
@@ -260,7 +260,9 @@ class BeamModel(Discretised):
             verts = self.mesh.point_tags.find(self.mesh.points[sup.at][0])
             targets = self._support_targets(sup)
             for sub, comp, value in targets:
-                V = self.W.sub(sub).sub(comp)
+                if (sub, comp) not in spaces:  # once: each sub() copies the dofmap, O(N)
+                    spaces[sub, comp] = self.W.sub(sub).sub(comp)
+                V = spaces[sub, comp]
                 dofs = fem.locate_dofs_topological(V, 0, verts)
                 c = fem.Constant(m, PETSc.ScalarType(value(0.0)))
                 bcs.append(fem.dirichletbc(c, dofs, V))

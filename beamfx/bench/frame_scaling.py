@@ -9,8 +9,8 @@ node, one load step) and finite kinematics (7 per node: the quaternion; one load
 Newton), with ``[solver] linear = "direct"`` (MUMPS) and ``"iterative"`` (CG + BoomerAMG on
 node blocks).
 
-``python -m beamfx.bench.frame_scaling run DIR [CELLS ...] [--linear direct|iterative]``
-solves on the ranks it is started on and writes ``DIR/frame_scaling_np<N>.json``;
+``python -m beamfx.bench.frame_scaling run DIR [CELLS ...] [--linear direct|iterative]
+[--kinematics linear|finite]`` solves on the ranks it is started on and writes ``DIR/frame_scaling_np<N>.json``;
 ``... report DIR`` writes ``DIR/frame_scaling.md`` and ``.json`` from the 1- and 2-rank
 files (``make bench-frame-scaling``). Each solve's peak memory is its own (the process's
 high-water mark is reset before it).
@@ -162,8 +162,12 @@ def measure(folder, cells, kinematics, linear, comm):
     split["other"] = max(0.0, seconds["solve"] - sum(split.values()))
     at = scene.probes["corner"]
     probe = evaluate_points(model, [at], full=False)[at]
-    seconds["output"] = _write_frame(folder / f"out_{comm.size}", scene, model, comm)
     reactions = entries(model)
+    krylov = solver.snes.getLinearSolveIterations()
+    # the tangent, its node-ordered copy and the hierarchy go before the frame is written (as
+    # at the end of a run), so that the frame's arrays do not come on top of them
+    solver.destroy()
+    seconds["output"] = _write_frame(folder / f"out_{comm.size}", scene, model, comm)
     out = {
         "cells": cells,
         "kinematics": kinematics,
@@ -173,7 +177,7 @@ def measure(folder, cells, kinematics, linear, comm):
         "members": len(scene.model.beams),
         "converged": bool(solved.steps) and solved.steps[-1].load_factor == 1.0,
         "newton_iterations": solved.newton_iterations,
-        "krylov_iterations": solver.snes.getLinearSolveIterations(),
+        "krylov_iterations": krylov,
         "seconds": {"scene": read, **seconds},
         "seconds_in_solve": split,
         "per_newton_iteration": {k: v / newton for k, v in split.items()},
@@ -184,7 +188,6 @@ def measure(folder, cells, kinematics, linear, comm):
         "reaction_force": _total_force(reactions["reactions"]),
         "reactions": {k: v["force"] for k, v in list(reactions["reactions"].items())[:4]},
     }
-    solver.destroy()
     return out
 
 
@@ -210,7 +213,13 @@ def _total_force(reactions):
     return [float(sum(r["force"][i] for r in reactions.values())) for i in range(3)]
 
 
-def run(cells=CELLS, linear=("direct", "iterative"), comm=None, save=None):
+def run(
+    cells=CELLS,
+    linear=("direct", "iterative"),
+    comm=None,
+    save=None,
+    kinematics=("linear", "finite"),
+):
     """Every size, kinematics and linear solver on ``comm``'s ranks (a list of dicts); the
     meshes go to a temporary folder. ``save(runs)`` is called on rank 0 after each solve."""
     import shutil
@@ -226,9 +235,9 @@ def run(cells=CELLS, linear=("direct", "iterative"), comm=None, save=None):
     out = []
     try:
         for n in cells:
-            for kinematics in ("linear", "finite"):
+            for kin in kinematics:
                 for solver in linear:
-                    out.append(measure(folder, n, kinematics, solver, comm))
+                    out.append(measure(folder, n, kin, solver, comm))
                     if comm.rank == 0:
                         print(json.dumps(_brief(out[-1])), flush=True)
                         if save:
@@ -252,9 +261,11 @@ def _brief(r):
 
 
 def main(argv=None):
-    """Command line: ``run DIR [CELLS ...] [--linear direct|iterative]`` measures (adding to
-    what ``DIR/frame_scaling_np<N>.json`` holds of other sizes), ``report DIR`` writes the
-    report."""
+    """Command line: ``run DIR [CELLS ...] [--linear direct|iterative] [--kinematics
+    linear|finite]`` measures (adding to what ``DIR/frame_scaling_np<N>.json`` holds of other
+    rows), ``report DIR`` writes the report. One row per process (``--linear`` and
+    ``--kinematics`` once each) keeps a large row's peak memory its own: a process does not
+    give all the memory of a finished row back to the system."""
     import argparse
 
     from mpi4py import MPI
@@ -264,6 +275,7 @@ def main(argv=None):
     cli.add_argument("folder", type=Path)
     cli.add_argument("cells", type=int, nargs="*", default=CELLS)
     cli.add_argument("--linear", choices=("direct", "iterative"), action="append")
+    cli.add_argument("--kinematics", choices=("linear", "finite"), action="append")
     args = cli.parse_args(argv)
     if args.what == "report":
         report(args.folder)
@@ -280,7 +292,8 @@ def main(argv=None):
         data = {"runs": keep + runs, "conditions": before.get("conditions", "")}
         out.write_text(json.dumps(data, indent=1, default=float))
 
-    run(tuple(args.cells), tuple(args.linear or ("direct", "iterative")), comm, save)
+    linear = tuple(args.linear or ("direct", "iterative"))
+    run(tuple(args.cells), linear, comm, save, tuple(args.kinematics or ("linear", "finite")))
 
 
 if __name__ == "__main__":

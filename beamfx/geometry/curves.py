@@ -6,6 +6,7 @@ Nodes are placed on the exact curve, so isoparametric P_k elements converge to i
 """
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -25,9 +26,9 @@ class Line:
     start: tuple
     end: tuple
 
-    @property
+    @cached_property
     def length(self):
-        """Arc length of the curve."""
+        """Arc length of the curve (computed once: frames ask it of 10⁵ members many times)."""
         return float(np.linalg.norm(np.subtract(self.end, self.start)))
 
     @property

@@ -395,6 +395,7 @@ def _check_points(model, probes, file, loads):
     """Every named point on a beam, every load's beam a beam (``loads``: the scene's
     ``[[loads]]`` tables, for the index of each load in the messages)."""
     from ..spec import resolve_point
+    from ..spec.model import beam_index
 
     at_load, on_beam = _load_indices(loads)
     named = [(f"supports[{i}].at", s.at) for i, s in enumerate(model.supports)]
@@ -402,9 +403,10 @@ def _check_points(model, probes, file, loads):
     named += [(f"springs[{i}].at", s.at) for i, s in enumerate(model.springs)]
     named += [(f"masses[{i}].at", m.at) for i, m in enumerate(model.point_masses)]
     named += [(f"probes[{i}].at", v) for i, v in enumerate(probes.values())]
+    index = beam_index(model)
     for where, at in named:
         try:
-            resolve_point(model, at)
+            resolve_point(model, at, index)
         except ValueError as e:
             raise SceneError(f"{file}: {where}: {e}") from None
     beams = [b.name for b in model.beams]

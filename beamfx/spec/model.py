@@ -174,22 +174,34 @@ class Model:
         raise KeyError(name)
 
 
-def resolve_point(model, at):
+def beam_index(model):
+    """{beam name: index} of ``model.beams`` (the first beam of a name), for
+    :func:`resolve_point` of many points."""
+    out = {}
+    for i, b in enumerate(model.beams):
+        out.setdefault(b.name, i)
+    return out
+
+
+def resolve_point(model, at, index=None):
     """Beam index, arc length and coordinates of a point name ``beam:start|end|<fraction>``.
+
+    ``index``: :func:`beam_index` of ``model``, given by a caller that resolves many points
+    (else it is built at every call: O(beams) each).
 
     Raises:
         ValueError: with the allowed forms, if ``at`` names no point of a beam.
     """
-    names = [b.name for b in model.beams]
+    index = beam_index(model) if index is None else index
     beam_name, colon, where = str(at).partition(":")
     if not colon:
         raise ValueError(f"{at!r}: write 'beam:start', 'beam:end' or 'beam:<fraction of length>'")
-    if beam_name not in names:
+    if beam_name not in index:
         raise ValueError(
-            f"{at!r} names no beam; beams are {names} (write 'beam:start', "
-            "'beam:end' or 'beam:<fraction of length>')"
+            f"{at!r} names no beam; beams are {[b.name for b in model.beams]} (write "
+            "'beam:start', 'beam:end' or 'beam:<fraction of length>')"
         )
-    b = names.index(beam_name)
+    b = index[beam_name]
     L = model.beams[b].curve.length
     if where in ("start", "end"):
         s = 0.0 if where == "start" else L
