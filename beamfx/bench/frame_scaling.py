@@ -98,14 +98,21 @@ def _event_seconds():
     }
 
 
+def _release():
+    """Freed memory back to the system: Python's cycles collected, and the heap that C's
+    allocator keeps after a free (PETSc's and hypre's blocks, a third of a solve's peak at
+    10³ cells) returned to it, so that it is not counted again under the next phase."""
+    import ctypes
+    import gc
+
+    gc.collect()
+    ctypes.CDLL("libc.so.6").malloc_trim(0)
+
+
 def _peak_mib(comm, reset=False):
     """Peak resident memory (VmHWM) of every rank in MiB; ``reset`` starts a new peak."""
     if reset:  # freed heap back to the system first, else the last solve's stays counted
-        import ctypes
-        import gc
-
-        gc.collect()
-        ctypes.CDLL("libc.so.6").malloc_trim(0)
+        _release()
         Path("/proc/self/clear_refs").write_text("5")
     status = Path("/proc/self/status").read_text().splitlines()
     kib = next(int(x.split()[1]) for x in status if x.startswith("VmHWM"))
@@ -167,6 +174,7 @@ def measure(folder, cells, kinematics, linear, comm):
     # the tangent, its node-ordered copy and the hierarchy go before the frame is written (as
     # at the end of a run), so that the frame's arrays do not come on top of them
     solver.destroy()
+    _release()
     seconds["output"] = _write_frame(folder / f"out_{comm.size}", scene, model, comm)
     out = {
         "cells": cells,
