@@ -293,12 +293,46 @@ hierarchy), solve (MUMPS: the triangular solves; CG: its iterations) and other (
 test, the step bookkeeping). Peak memory is each solve's resident high-water mark per rank
 (model, forms, matrices, factor or hierarchy; about 120 MiB of it are the libraries).
 Outside the Newton iterations: building the model and writing one ParaView frame (each rank
-its own piece, nothing gathered), in the last columns.
+its own piece, nothing gathered), in the last columns. The frame is written after the
+solver's matrix, node-ordered copy and hierarchy are freed and the heap C's allocator keeps
+after a free is returned to the system (as at the end of a run), so the whole case's peak is
+the larger of the solve's and the model's plus the frame's; rows measured before 24 Nov 2026
+wrote the frame on top of the solver (the notes below say which).
 
 Before the node blocks (CG + smoothed-aggregation GAMG on the unknowns one by one, the
 previous version of this page, measured the same way): 70, 115, 224 and 492 CG iterations
 for the linear lattice at 918, 11,286, 83,766 and 857,478 unknowns (1 rank), 293 s per
 Newton iteration and a 15.9 GB peak at the last.
+
+**Building the model** (profiled with cProfile and the resident memory at the phase
+boundaries, 1 rank, finite kinematics; CPU seconds of reading the scene and building the
+model, before → after the changes of 24 Nov 2026): 8.5 → 3.4 s at 10³ cells (97,727
+unknowns) and 29.7 → 8.0 s at 14³ (262,647); resident after the build 278 → 216 MiB and
+695 → 376 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB. What grew
+faster than the members: every per-beam pass over all cells (`cell_beam == i` for each
+beam: the arc lengths and section fields of the cells, the swept surface of the frame),
+each point name resolved through a list of all beam names (supports, loads, probes and the
+scene's checks), the stiffness ratio and section values computed per member although the
+members share two sections, `Line.length` recomputed at each of its million calls, and the
+degrees-of-freedom sub-map copied per supported component. Now the cells are grouped by one
+sort, the names indexed once, the section values cached per section and length; the
+answers are bit-identical (fields, probes, reactions and the written .vtu files of a 3³
+lattice). At 22³ cells (10⁶ unknowns) the build takes 56 CPU s under the profiler (87 s of wall-clock
+time in the row below, beside other jobs; 1,547 s before, at the load of the first 10⁶ run) and
+holds 1.8 GB. What is left is linear in the members but Python per member: the mesh's
+vertex list and overlap check (each member's element breaks computed twice), the joint
+search, the 529 point loads of the top face (each adds a term and a DG weight field over
+the whole mesh to the residual: a joint of more than two elements takes a dead load
+exactly on one element; a form of n such terms costs O(n²) to add up in UFL and O(n ×
+cells) to assemble: at 10³ cells (linear kinematics) the 121 load terms are 0.048 of the 0.053 CPU s of
+one residual; one field for all loads of a history would make it O(cells), a change of the
+shared model code left for later).
+
+**The frame's memory.** The swept surface of the ParaView frame has 160 points per element
+(32 around the circle at 5 stations) with their u, N and M: at 14³ cells writing it took
+1.6 GB above the solved model, at 22³ about 4.5 GB (VTK holds a copy of its arrays
+while it writes them). It, not the solver, set the whole case's peak of the first 10⁶ run (16.4
+GB: the frame on top of the solver's 8.9 GB).
 
 **Noise.** Measured while other agents' jobs shared the 2 cores of this machine (load
 average 7–13): every time is inflated and noisy (±30 % and more; the 2-rank runs suffer
