@@ -128,17 +128,22 @@ def project(one, two, ranks):
 
 
 def _projection(runs):
-    """(lines, {case: {ranks: (low, high)}}) for the largest size run on 1 and 2 ranks."""
+    """(lines, {case: {ranks: (low, high)}}) for each case (kinematics, linear solver) from its
+    largest size run on 1 and 2 ranks."""
     pairs = [k[:3] for k in runs if k[3] == 2 and (*k[:3], 1) in runs]
     if not pairs:
         return [], {}
-    n = max(k[0] for k in pairs)
+    largest = {}
+    for n, kin, lin in pairs:
+        largest[kin, lin] = max(largest.get((kin, lin), 0), n)
+    sizes = ", ".join(f"{n}³" for n in sorted(set(largest.values())))
     lines = [
         "",
         "## Projection to 8–64 ranks (a projection, not measured)",
         "",
         (
-            f"From the {n}³ lattice's 1- and 2-rank runs: each phase keeps the efficiency per "
+            f"From each case's largest lattice run on 1 and 2 ranks ({sizes}): each phase keeps "
+            "the efficiency per "
             "doubling of ranks that it showed from 1 to 2 ranks (between 1/2, no speed-up, "
             "and 1, perfect); the iterative solve's Krylov "
             "iterations stay at the 2-rank count (low) or grow by the measured 1-to-2-rank "
@@ -149,20 +154,20 @@ def _projection(runs):
         ),
         "",
         (
-            "| kinematics | linear solver | s per Newton iteration at 8 | 16 | 32 | 64 ranks "
-            "| peak MiB per rank at 64 |"
+            "| cells | kinematics | linear solver | s per Newton iteration at 8 | 16 | 32 "
+            "| 64 ranks | peak MiB per rank at 64 |"
         ),
-        "|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|",
     ]
     base = min(min(r["peak_MiB"]) for r in runs.values())
     out = {}
-    for kin, lin in sorted({k[1:3] for k in pairs if k[0] == n}):
+    for (kin, lin), n in sorted(largest.items()):
         one, two = runs[(n, kin, lin, 1)], runs[(n, kin, lin, 2)]
         proj = {p: project(one, two, p) for p in (8, 16, 32, 64)}
         out[f"{n}/{kin}/{lin}"] = proj
         cells = " | ".join(f"{lo:.3g} – {hi:.3g}" for lo, hi in proj.values())
         mem = base + (max(two["peak_MiB"]) - base) * 2 / 64
-        lines.append(f"| {kin} | {lin} | {cells} | {mem:.0f} |")
+        lines.append(f"| {n}³ | {kin} | {lin} | {cells} | {mem:.0f} |")
     return lines, out
 
 
@@ -307,35 +312,38 @@ Newton iteration and a 15.9 GB peak at the last.
 **Building the model** (profiled with cProfile and the resident memory at the phase
 boundaries, 1 rank, finite kinematics; CPU seconds of reading the scene and building the
 model, before → after the changes of 24 Nov 2026): 8.5 → 3.4 s at 10³ cells (97,727
-unknowns) and 29.7 → 8.0 s at 14³ (262,647); resident after the build 278 → 216 MiB and
-695 → 376 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB. What grew
-faster than the members: every per-beam pass over all cells (`cell_beam == i` for each
-beam: the arc lengths and section fields of the cells, the swept surface of the frame),
-each point name resolved through a list of all beam names (supports, loads, probes and the
-scene's checks), the stiffness ratio and section values computed per member although the
-members share two sections, `Line.length` recomputed at each of its million calls, and the
+unknowns) and 29.7 → 8.0 s at 14³ (262,647); resident after the build 278 → 216 MiB and 695
+→ 376 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB. What grew faster
+than the members: every per-beam pass over all cells (`cell_beam == i` for each beam: the
+arc lengths and section fields of the cells, the swept surface of the frame), each point
+name resolved through a list of all beam names (supports, loads, probes and the scene's
+checks), the stiffness ratio and section values computed per member although the members
+share two sections, `Line.length` recomputed at each of its million calls, and the
 degrees-of-freedom sub-map copied per supported component. Now the cells are grouped by one
-sort, the names indexed once, the section values cached per section and length; the
-answers are bit-identical (fields, probes, reactions and the written .vtu files of a 3³
-lattice). At 22³ cells (10⁶ unknowns) the build takes 56 CPU s under the profiler (87 s of wall-clock
-time in the row below, beside other jobs; 1,547 s before, at the load of the first 10⁶ run) and
-holds 1.8 GB. What is left is linear in the members but Python per member: the mesh's
-vertex list and overlap check (each member's element breaks computed twice), the joint
-search, the 529 point loads of the top face (each adds a term and a DG weight field over
-the whole mesh to the residual: a joint of more than two elements takes a dead load
-exactly on one element; a form of n such terms costs O(n²) to add up in UFL and O(n ×
-cells) to assemble: at 10³ cells (linear kinematics) the 121 load terms are 0.048 of the 0.053 CPU s of
-one residual; one field for all loads of a history would make it O(cells), a change of the
-shared model code left for later).
+sort, the names indexed once, the section values cached per section and length; the answers
+are bit-identical (fields, probes, reactions and the written .vtu files of a 3³ lattice). At
+22³ cells (10⁶ unknowns) reading the scene and building the model take 33 s (linear) and 43
+s (finite) of wall-clock time in the rows below (1,547 s before, at the load of the first
+10⁶ run; 56 CPU s under the profiler), and the model holds 1.8 GB. What is left is linear in
+the members but Python per member: the mesh's vertex list and overlap check (each member's
+element breaks computed twice), the joint search, the 529 point loads of the top face (each
+adds a term and a DG weight field over the whole mesh to the residual: a joint of more than
+two elements takes a dead load exactly on one element; a form of n such terms costs O(n²) to
+add up in UFL and O(n × cells) to assemble: at 10³ cells (linear kinematics) the 121 load
+terms are 0.048 of the 0.053 CPU s of one residual; one field for all loads of a history
+would make it O(cells), a change of the shared model code left for later).
 
 **The frame's memory.** The swept surface of the ParaView frame has 160 points per element
-(32 around the circle at 5 stations) with their u, N and M: at 14³ cells writing it took
-1.6 GB above the solved model, at 22³ about 4.5 GB (VTK holds a copy of its arrays
-while it writes them). It, not the solver, set the whole case's peak of the first 10⁶ run (16.4
-GB: the frame on top of the solver's 8.9 GB).
+(32 around the circle at 5 stations) with their u, N and M: writing it took 1.6 GB at 14³
+cells and 8 GB at 22³ (from 3.7 to 11.7 GB on 1 rank after the solver was freed, from 4.9 to
+12.4 GB summed over 2 ranks; VTK holds a copy of its arrays while it writes them). It, not
+the solver, sets the whole case's peak at 10⁶ unknowns (11.7 GB against the solve's 6.5 GB,
+finite, 1 rank; the first 10⁶ run's 16.4 GB was the frame on top of the solver's 8.9 GB).
+Writing the surface in pieces, or the centre line alone (`[output] formats = ["vtu"]`),
+would lower it; not done here.
 
 **Noise.** Measured while other agents' jobs shared the 2 cores of this machine (load
-average 7–13): every time is inflated and noisy (±30 % and more; the 2-rank runs suffer
+average 7–13 for the 2³–10³ rows, 3–7 for the 22³ ones): every time is inflated and noisy (±30 % and more; the 2-rank runs suffer
 most, since their ranks wait for each other), and each size was run once. Ratios between
 neighbouring rows are more trustworthy than the absolute seconds; rerun
 `make bench-frame-scaling` on a quiet machine."""
