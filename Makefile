@@ -41,14 +41,16 @@ bench-solid-scaling: install
 	$(MPIRUN) $(PY) -m beamfx.bench.solid_scaling run docs/validation
 	$(PY) -m beamfx.bench.solid_scaling report docs/validation
 
-# BCC lattice frames of 10³ to 10⁶ unknowns on 1 and 2 ranks, MUMPS and CG + GAMG (long: the
-# 10⁶ size alone takes tens of minutes and several GiB; not part of `make test`)
+# BCC lattice frames of 10³ to 10⁶ unknowns on 1 and 2 ranks, MUMPS and CG + BoomerAMG (long:
+# each 10⁶ row, in its own process, takes minutes and up to 12 GB; not part of `make test`)
 FRAME_CELLS := 2 5 10
 bench-frame-scaling: install
 	$(PY) -m beamfx.bench.frame_scaling run docs/validation $(FRAME_CELLS)
 	$(MPIRUN) $(PY) -m beamfx.bench.frame_scaling run docs/validation $(FRAME_CELLS)
-	$(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative
-	$(MPIRUN) $(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative
+	$(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative --kinematics linear
+	$(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative --kinematics finite
+	$(MPIRUN) $(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative --kinematics linear
+	$(MPIRUN) $(PY) -m beamfx.bench.frame_scaling run docs/validation 22 --linear iterative --kinematics finite
 	$(PY) -m beamfx.bench.frame_scaling report docs/validation
 
 # beamfx beside Exudyn, PyElastica, CalculiX, OpenSeesPy and pyBModes (peer venv PEERS_VENV,
