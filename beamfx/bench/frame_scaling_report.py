@@ -301,8 +301,8 @@ Outside the Newton iterations: building the model and writing one ParaView frame
 its own piece, nothing gathered), in the last columns. The frame is written after the
 solver's matrix, node-ordered copy and hierarchy are freed and the heap C's allocator keeps
 after a free is returned to the system (as at the end of a run), so the whole case's peak is
-the larger of the solve's and the model's plus the frame's; rows measured before 24 Nov 2026
-wrote the frame on top of the solver (the notes below say which).
+the larger of the solve's and the model's plus the frame's; the 2³–10³ rows, measured
+before that change, wrote the frame on top of the solver.
 
 Before the node blocks (CG + smoothed-aggregation GAMG on the unknowns one by one, the
 previous version of this page, measured the same way): 70, 115, 224 and 492 CG iterations
@@ -311,11 +311,11 @@ Newton iteration and a 15.9 GB peak at the last.
 
 **Building the model** (profiled with cProfile and the resident memory at the phase
 boundaries, 1 rank, finite kinematics; CPU seconds of reading the scene and building the
-model, before → after the changes of 24 Nov 2026): 8.5 → 3.4 s at 10³ cells (97,727
-unknowns) and 29.7 → 8.0 s at 14³ (262,647); resident after the build 278 → 216 MiB and 695
-→ 376 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB. What grew faster
-than the members: every per-beam pass over all cells (`cell_beam == i` for each beam: the
-arc lengths and section fields of the cells, the swept surface of the frame), each point
+model, before → after the changes that came with the 22³ rows): 8.5 → 3.4 s at 10³ cells
+(97,727 unknowns) and 29.7 → 8.0 s at 14³ (262,647); resident after the build 278 → 216 MiB
+and 695 → 376 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB. What grew
+faster than the members: every per-beam pass over all cells (`cell_beam == i` for each beam:
+the arc lengths and section fields of the cells, the swept surface of the frame), each point
 name resolved through a list of all beam names (supports, loads, probes and the scene's
 checks), the stiffness ratio and section values computed per member although the members
 share two sections, `Line.length` recomputed at each of its million calls, and the
@@ -343,10 +343,10 @@ Writing the surface in pieces, or the centre line alone (`[output] formats = ["v
 would lower it; not done here.
 
 **Noise.** Measured while other agents' jobs shared the 2 cores of this machine (load
-average 7–13 for the 2³–10³ rows, 3–7 for the 22³ ones): every time is inflated and noisy (±30 % and more; the 2-rank runs suffer
-most, since their ranks wait for each other), and each size was run once. Ratios between
-neighbouring rows are more trustworthy than the absolute seconds; rerun
-`make bench-frame-scaling` on a quiet machine."""
+average 7–13 for the 2³–10³ rows, 3–7 for the 22³ ones): every time is inflated and noisy
+(±30 % and more; the 2-rank runs suffer most, since their ranks wait for each other), and
+each size was run once. Ratios between neighbouring rows are more trustworthy than the
+absolute seconds; rerun `make bench-frame-scaling` on a quiet machine."""
 
 
 def report(folder, notes=SETUP):
