@@ -51,8 +51,9 @@ def _element_breaks(spec):
     )
 
 
-def _nodes_and_cells(specs, degree, tol):
-    """Rank-0 node coordinates, cells (DOLFINx order), beam of each cell and its (s_a, s_b)."""
+def _nodes_and_cells(specs, degree, tol, breaks=None):
+    """Rank-0 node coordinates, cells (DOLFINx order), beam of each cell and its (s_a, s_b);
+    ``breaks``: :func:`_element_breaks` of each spec, if known."""
     pts, cells, beam_of, spans = [], [], [], []
     vertex_ids = {}  # rounded coordinate -> node index, merges shared vertices
 
@@ -64,7 +65,7 @@ def _nodes_and_cells(specs, degree, tol):
         return vertex_ids[key]
 
     for b, spec in enumerate(specs):
-        s_v = _element_breaks(spec)
+        s_v = _element_breaks(spec) if breaks is None else breaks[b]
         for sa, sb in pairwise(s_v):
             local = np.linspace(sa, sb, degree + 1)
             xyz = spec.curve.points(local)
@@ -83,18 +84,19 @@ def tolerance(specs):
     return 1e-9 * size
 
 
-def overlapping_cells(specs):
+def overlapping_cells(specs, tol=None, breaks=None):
     """(index of the spec, why) if the element vertices of ``specs`` would make a broken
     mesh, or None.
 
     Vertices closer than :func:`tolerance` are merged (that is how beams share a joint, and a
     closed curve closes). A curve that runs over itself (an arc of 720°) would then give two
-    cells on the same two vertices, or a cell whose two ends are one vertex.
+    cells on the same two vertices, or a cell whose two ends are one vertex. ``tol`` and
+    ``breaks`` (:func:`_element_breaks` of each spec): given by a caller that has them.
     """
-    tol = tolerance(specs)
+    tol = tolerance(specs) if tol is None else tol
     ids, seen = {}, {}
     for index, spec in enumerate(specs):
-        s_v = _element_breaks(spec)
+        s_v = _element_breaks(spec) if breaks is None else breaks[index]
         keys = np.round(np.asarray(spec.curve.points(s_v), float) / tol).astype(np.int64)
         v = [ids.setdefault(tuple(k), len(ids)) for k in keys]
         for i, (a, b) in enumerate(pairwise(v)):
@@ -136,11 +138,14 @@ def build_mesh(comm, specs, degree, named_points=None):
     tol = tolerance(specs)
     # a curve over itself gives duplicated cells, on which DOLFINx's topology aborts the
     # process (munmap_chunk, SIGABRT) or fails on some ranks only: refuse it on every rank
-    problem = comm.bcast(overlapping_cells(specs) if comm.rank == 0 else None, root=0)
+    # each beam's element breaks once on rank 0, for the overlap check and the node list
+    breaks = [_element_breaks(s) for s in specs] if comm.rank == 0 else None
+    problem = comm.bcast(overlapping_cells(specs, tol, breaks) if comm.rank == 0 else None, root=0)
     if problem:
         raise ValueError(problem[1])
     if comm.rank == 0:
-        x, cells, beam_of, spans = _nodes_and_cells(specs, degree, tol)
+        x, cells, beam_of, spans = _nodes_and_cells(specs, degree, tol, breaks)
+        del breaks
     else:
         x, cells = np.empty((0, 3)), np.empty((0, degree + 1), np.int64)
         beam_of, spans = None, None
