@@ -313,28 +313,27 @@ Newton iteration and a 15.9 GB peak at the last.
 boundaries, 1 rank, finite kinematics; CPU seconds of reading the scene and building the
 model, before → after the changes that came with the 22³ rows): 7.8 → 2.6 s at 10³ cells
 (97,727 unknowns) and 28.3 → 6.9 s at 14³ (262,647); resident after the build 278 → 215 MiB
-and 695 → 375 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB (before the
-frame was written after the solver was freed). What grew faster than the members: every
-per-beam pass over all cells (`cell_beam == i` for each beam: the arc lengths and section
-fields of the cells, the swept surface of the frame), each point name resolved through a
-list of all beam names (supports, loads, probes and the scene's checks), the stiffness ratio
-and section values computed per member although the members share two sections,
-`Line.length` recomputed at each of its million calls, and the degrees-of-freedom sub-map
-copied per supported component. Now the cells are grouped by one sort, the names indexed
-once, the section values cached per section and length, each member's element breaks
-computed once (not for the overlap check and again for the node list); the answers are
-bit-identical (fields, probes, reactions and the written .vtu files of a 3³ lattice). At 22³
-cells (10⁶ unknowns) reading the scene and building the model take 33 s (linear) and 43 s
-(finite) of wall-clock time in the rows below (1,547 s before, at the load of the first 10⁶
-run; 56 CPU s under the profiler), and the model holds 1.8 GB (these rows ran before the
-element breaks were computed once, 15 % of the build at 14³). What is left is linear in the
-members but Python per member: the mesh's vertex list and overlap check, the joint search,
-the 529 point loads of the top face (each adds a term and a DG weight field over the whole
-mesh to the residual: a joint of more than two elements takes a dead load exactly on one
-element; a form of n such terms costs O(n²) to add up in UFL and O(n × cells) to assemble:
-at 10³ cells (linear kinematics) the 121 load terms are 0.048 of the 0.053 CPU s of one
-residual; one field for all loads of a history would make it O(cells), a change of the
-shared model code left for later).
+and 695 → 375 MiB; the whole case's peak 1,304 → 1,110 MiB and 3,460 → 2,958 MiB (most of it
+the frame's, below). What grew faster than the members: every per-beam pass over all cells
+(`cell_beam == i` for each beam: the arc lengths and section fields of the cells, the swept
+surface of the frame), each point name resolved through a list of all beam names (supports,
+loads, probes and the scene's checks), the stiffness ratio and section values computed per
+member although the members share two sections, `Line.length` recomputed at each of its
+million calls, and the degrees-of-freedom sub-map copied per supported component. Now the
+cells are grouped by one sort, the names indexed once, the section values cached per section
+and length, each member's element breaks computed once (not for the overlap check and again
+for the node list); the answers are bit-identical (fields, probes, reactions and the written
+.vtu files of a 3³ lattice). At 22³ cells (10⁶ unknowns) reading the scene and building the
+model take 33 s (linear) and 43 s (finite) of wall-clock time in the rows below (1,547 s
+before, at the load of the first 10⁶ run; 56 CPU s under the profiler), and the model holds
+1.8 GB (these rows ran before the element breaks were computed once, 15 % of the build at
+14³). What is left is linear in the members but Python per member: the mesh's vertex list
+and overlap check, the joint search, the 529 point loads of the top face (each adds a term
+and a DG weight field over the whole mesh to the residual: a joint of more than two elements
+takes a dead load exactly on one element; a form of n such terms costs O(n²) to add up in
+UFL and O(n × cells) to assemble: at 10³ cells (linear kinematics) the 121 load terms are
+0.048 of the 0.053 CPU s of one residual; one field for all loads of a history would make it
+O(cells), a change of the shared model code left for later).
 
 **The frame's memory.** The swept surface of the ParaView frame has 160 points per element
 (32 around the circle at 5 stations) with their u, N and M: writing it took 1.6 GB at 14³
