@@ -70,6 +70,13 @@ INERTIA_JUMP = 3
 #: how often a step that passed a limit point with another critical point is halved to
 #: separate them
 SEPARATIONS = 4
+#: how often a step whose inertia changed but whose critical point could not be located
+#: on it is redone with half the arc length (:meth:`ArcLengthSolver._bifurcation`): the
+#: eigenvalue's zero lies on a smooth path between the step's ends, so a location that
+#: fails says the corrector converged onto another branch (one the inertia changes by one
+#: to, e.g. the rising continuation of a nearly perfect bifurcation that is a sharp limit
+#: point on the path: the shallow arch with EA × 1e6)
+RELOCATIONS = 6
 #: a path is trivial in the measured dofs where the load moves them (‖δw_f‖ per unit load
 #: factor) by less than this fraction of the geometric arc length (:meth:`ArcLengthSolver._trivial`)
 TRIVIAL = 1e-12
@@ -576,7 +583,10 @@ class ArcLengthSolver:
             if self._jumped(path, saved, state, log):
                 dw.destroy()
                 continue
-            if self._accept(path, saved, (dw, dlam, its, res), state, on_step, log):
+            outcome = self._accept(path, saved, (dw, dlam, its, res), state, on_step, log)
+            if outcome == "redo":
+                continue
+            if outcome == "switched":
                 reached = False  # switched onto another branch before the step's end
             if reached:
                 reason = "target"
@@ -666,8 +676,9 @@ class ArcLengthSolver:
     def _accept(self, path, saved, taken, state, on_step, log):
         """Record the converged step ``taken`` from the state ``saved``, with ``state`` =
         (inertia, forward) at its end; the critical point it passed (located, and the branch
-        switched, for a bifurcation). Returns whether the path switched branch (it no longer
-        ends where the step did)."""
+        switched, for a bifurcation). Returns "switched" when the path switched branch (it no
+        longer ends where the step did), "redo" when the step is to be redone shorter (its
+        critical point could not be located on it: state put back, Δl halved), else None."""
         dw, dlam, its, res = taken
         lam = path.lam + dlam
         count, forward = state
@@ -686,13 +697,15 @@ class ArcLengthSolver:
             switch = kind == "bifurcation" and self.settings.branch == "secondary"
             if kind == "limit" and abs(count - path.count) != 1:
                 path.critical.append(point)
-            elif self._bifurcation(
-                path, saved, taken, point, switch and not path.switched, on_step, log
-            ):
-                return True
+            else:
+                outcome = self._bifurcation(
+                    path, saved, taken, point, switch and not path.switched, on_step, log
+                )
+                if outcome:
+                    return outcome
         length = self._length(dw, dlam)
         self._record(path, (dw, dlam, its, res), length, count, forward, on_step, log)
-        return False
+        return None
 
     def _record(self, path, taken, length, count, forward, on_step, log, note=""):
         """Append the step ``taken`` (its end is the current state) and move the path on."""
@@ -746,8 +759,9 @@ class ArcLengthSolver:
     def _bifurcation(self, path, saved, taken, point, switch, on_step, log):
         """Locate the critical point (bifurcation or limit) the step ``taken`` passed; with
         ``switch``, record the located point and a first step along the secondary branch and
-        return True; else note the point, put the state back at the step's end and return
-        False."""
+        return "switched"; else note the point, put the state back at the step's end and
+        return None. A point that cannot be located: "redo" (:meth:`_unlocated`), or noted
+        after :data:`RELOCATIONS` halvings."""
         dw, dlam = taken[:2]
         t = time.perf_counter()
         end, lam_end, cached = self.w.vector.copy(), path.lam + dlam, self._cached
@@ -769,6 +783,11 @@ class ArcLengthSolver:
                     f"  {point.kind} point located at load factor {lam_c:.8g} ({n} solves; "
                     f"the inertia changes between {lo:.10g} and {hi:.10g})"
                 )
+        if x is None and self._unlocated(path, saved, point, log):
+            cached.destroy()
+            end.destroy()
+            dw.destroy()
+            return "redo"
         if x is None or not switch:
             path.critical.append(point)
             if x is not None:
@@ -776,7 +795,7 @@ class ArcLengthSolver:
             self._restore(end, lam_end)
             self._cached = cached
             end.destroy()
-            return False
+            return None
         cached.destroy()
         end.destroy()
         path.critical.append(point._replace(switched=True))
@@ -787,6 +806,20 @@ class ArcLengthSolver:
         located = (dw_c, lam_c - path.lam, 0, ())
         self._record(path, located, x, None, path.forward, on_step, log, "bifurcation point")
         self._switch(path, phi, dl, on_step, log)
+        return "switched"
+
+    def _unlocated(self, path, saved, point, log):
+        """After a failed location of ``point``: whether the step is to be redone with half
+        the arc length (at most :data:`RELOCATIONS` times in a row; the state is then put
+        back at its start). The eigenvalue that changed sign has its zero on a smooth path
+        between the step's ends, which the probes (steps from the start, shorter) reach;
+        when they do not, the end is on another branch. Raises SolveFailed when Δl gets
+        too small."""
+        why = f"the {point.kind} point could not be located on the step: another branch"
+        if sum(1 for t in path.tried if t[1] == why) >= RELOCATIONS:
+            return False
+        self._restore(saved, path.lam)
+        self._reject(path, (path.control.size, why, (), None), "branch jump", log)
         return True
 
     def _locate(self, path, saved, end, point):
