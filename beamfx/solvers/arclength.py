@@ -70,13 +70,19 @@ INERTIA_JUMP = 3
 #: how often a step that passed a limit point with another critical point is halved to
 #: separate them
 SEPARATIONS = 4
-#: how often a step whose inertia changed but whose critical point could not be located
-#: on it is redone with half the arc length (:meth:`ArcLengthSolver._bifurcation`): the
+#: how often a step whose inertia changed, whose corrector moved by more than
+#: :data:`TRUST` Δl from its predictor and whose critical point could not be located on it
+#: is redone with half the arc length (:meth:`ArcLengthSolver._unlocated`): the
 #: eigenvalue's zero lies on a smooth path between the step's ends, so a location that
-#: fails says the corrector converged onto another branch (one the inertia changes by one
-#: to, e.g. the rising continuation of a nearly perfect bifurcation that is a sharp limit
-#: point on the path: the shallow arch with EA × 1e6)
+#: fails after a far move says the corrector converged onto another branch (one the
+#: inertia changes by one to, e.g. the rising continuation of a nearly perfect bifurcation
+#: that is a sharp limit point on the path: the shallow arch with EA × 1e6)
 RELOCATIONS = 6
+#: a corrector that moved the step less than this fraction of Δl from its (tangent)
+#: predictor stayed on the path (a turn below ~14°): a location failing there is the
+#: probes' trouble near a singular tangent, not another branch. The shallow arch's branch
+#: jump moved 0.57 Δl (33°); steps across its critical points at ×1 move < 0.02 Δl
+TRUST = 0.25
 #: a path is trivial in the measured dofs where the load moves them (‖δw_f‖ per unit load
 #: factor) by less than this fraction of the geometric arc length (:meth:`ArcLengthSolver._trivial`)
 TRIVIAL = 1e-12
@@ -184,6 +190,7 @@ class _Path:
     critical: list
     tried: list  # (Δl, why, residuals, detail) of the failed attempts at the next step
     switched: bool = False
+    turn: float = 0.0  # the corrector's move from the predictor / Δl in the step being taken
 
 
 class ArcLengthSolver:
@@ -248,6 +255,7 @@ class ArcLengthSolver:
         self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
         self._fixed = False  # the step's corrector at a fixed load factor (a trivial path)
+        self.turn = 0.0  # of the last converged step: its corrector's move / Δl (_step)
         self._cached, self._prepared = None, False
 
         n_owned = (
@@ -426,7 +434,8 @@ class ArcLengthSolver:
                 floor/μ).
 
         Returns:
-            (Δw, Δλ, iterations, residuals); w and λ hold the new point.
+            (Δw, Δλ, iterations, residuals); w and λ hold the new point, and ``turn`` the
+            corrector's move from the predictor over Δl (0 at a fixed load factor).
         """
         s = self.settings
         self._fixed = False
@@ -439,6 +448,8 @@ class ArcLengthSolver:
         for it in range(s.max_iterations + 1):
             residuals.append(self._residual(lam_n + dlam))
             if self._converged(it, residuals[-1], lam_n + dlam, ddlam):
+                self.turn = 0.0 if fixed or not dl else self._moved(dw, dlam, dw0, dlam0) / dl
+                dw0.destroy()
                 return dw, dlam, it, tuple(residuals)
             if residuals[-1] > s.divergence * residuals[0]:
                 raise self._failed("DIVERGED_DTOL", "diverged", residuals)
@@ -463,6 +474,15 @@ class ArcLengthSolver:
         raise self._failed(
             "DIVERGED_MAX_IT", f"no convergence in {s.max_iterations} iterations", residuals
         )
+
+    def _moved(self, dw, dlam, dw0, dlam0):
+        """How far the corrector took the step (Δw, Δλ) from its predictor (Δw₀, Δλ₀), in
+        the arc-length metric."""
+        d = dw.copy()
+        d.axpy(-1.0, dw0)
+        moved = self._length(d, dlam - dlam0)
+        d.destroy()
+        return moved
 
     def _converged(self, it, fnorm, lam, ddlam):
         """Newton's convergence test (:class:`~beamfx.solvers.convergence.ScaledTest`) at
@@ -571,6 +591,7 @@ class ArcLengthSolver:
             if taken is None:
                 continue
             dw, dlam, its, res = taken
+            path.turn = self.turn  # before a landing or the location's probes change it
             reached = target_load_factor is not None and (
                 (path.lam - target_load_factor) * (path.lam + dlam - target_load_factor) < 0
                 or path.lam + dlam == target_load_factor
@@ -813,10 +834,11 @@ class ArcLengthSolver:
         the arc length (at most :data:`RELOCATIONS` times in a row; the state is then put
         back at its start). The eigenvalue that changed sign has its zero on a smooth path
         between the step's ends, which the probes (steps from the start, shorter) reach;
-        when they do not, the end is on another branch. Raises SolveFailed when Δl gets
+        when they do not and the corrector moved the step far from its predictor (more than
+        :data:`TRUST` Δl), the end is on another branch. Raises SolveFailed when Δl gets
         too small."""
         why = f"the {point.kind} point could not be located on the step: another branch"
-        if sum(1 for t in path.tried if t[1] == why) >= RELOCATIONS:
+        if path.turn <= TRUST or sum(1 for t in path.tried if t[1] == why) >= RELOCATIONS:
             return False
         self._restore(saved, path.lam)
         self._reject(path, (path.control.size, why, (), None), "branch jump", log)
