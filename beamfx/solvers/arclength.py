@@ -41,6 +41,13 @@ predictor, so it replaces one the next step would make) and a change of the coun
 limit or bifurcation point (:mod:`beamfx.solvers.bifurcation`): bifurcations are located, and
 with ``branch = "secondary"`` the trace leaves the primary path at the first one.
 
+Branch jumps: a converged step is redone with half the arc length when its inertia changed
+by more than :data:`INERTIA_JUMP`, or when it changed at all but the critical point cannot be
+located on the step while its corrector moved it more than :data:`TRUST` Δl from the
+predictor (the zero of the eigenvalue lies on a smooth path between the step's ends, which
+the location's shorter probes from the start follow: an end they cannot reach after a far
+corrector move is on another branch, one the inertia differs from by one).
+
 References:
     M. A. Crisfield, "A fast incremental/iterative solution procedure that handles
     snap-through", Computers & Structures 13 (1981) 55–62.
