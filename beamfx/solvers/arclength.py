@@ -599,10 +599,7 @@ class ArcLengthSolver:
                 continue
             dw, dlam, its, res = taken
             path.turn = self.turn  # before a landing or the location's probes change it
-            reached = target_load_factor is not None and (
-                (path.lam - target_load_factor) * (path.lam + dlam - target_load_factor) < 0
-                or path.lam + dlam == target_load_factor
-            )
+            reached = _crosses(path.lam, dlam, target_load_factor)
             if reached and path.lam + dlam != target_load_factor:
                 landed = self._land(saved, path.lam, dw, dlam, target_load_factor)
                 if landed:
@@ -614,8 +611,7 @@ class ArcLengthSolver:
             outcome = self._accept(path, saved, (dw, dlam, its, res), state, on_step, log)
             if outcome == "redo":
                 continue
-            if outcome == "switched":
-                reached = False  # switched onto another branch before the step's end
+            reached = reached and outcome != "switched"  # a switch ends before the step's end
             if reached:
                 reason = "target"
                 break
@@ -976,6 +972,13 @@ class ArcLengthSolver:
 WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)
 #: how often a factorisation is retried with a larger workspace (ICNTL(14) times 4 each)
 WORKSPACE_RETRIES = 4
+
+
+def _crosses(lam, dlam, target):
+    """Whether the step from ``lam`` by ``dlam`` reaches or crosses ``target`` (None: no)."""
+    if target is None:
+        return False
+    return (lam - target) * (lam + dlam - target) < 0 or lam + dlam == target
 
 
 def _larger_workspace(ksp):
