@@ -41,6 +41,13 @@ predictor, so it replaces one the next step would make) and a change of the coun
 limit or bifurcation point (:mod:`beamfx.solvers.bifurcation`): bifurcations are located, and
 with ``branch = "secondary"`` the trace leaves the primary path at the first one.
 
+Branch jumps: a converged step is redone with half the arc length when its inertia changed
+by more than :data:`INERTIA_JUMP`, or when it changed at all but the critical point cannot be
+located on the step while its corrector moved it more than :data:`TRUST` Δl from the
+predictor (the zero of the eigenvalue lies on a smooth path between the step's ends, which
+the location's shorter probes from the start follow: an end they cannot reach after a far
+corrector move is on another branch, one the inertia differs from by one).
+
 References:
     M. A. Crisfield, "A fast incremental/iterative solution procedure that handles
     snap-through", Computers & Structures 13 (1981) 55–62.
@@ -70,6 +77,19 @@ INERTIA_JUMP = 3
 #: how often a step that passed a limit point with another critical point is halved to
 #: separate them
 SEPARATIONS = 4
+#: how often a step whose inertia changed, whose corrector moved by more than
+#: :data:`TRUST` Δl from its predictor and whose critical point could not be located on it
+#: is redone with half the arc length (:meth:`ArcLengthSolver._unlocated`): the
+#: eigenvalue's zero lies on a smooth path between the step's ends, so a location that
+#: fails after a far move says the corrector converged onto another branch (one the
+#: inertia changes by one to, e.g. the rising continuation of a nearly perfect bifurcation
+#: that is a sharp limit point on the path: the shallow arch with EA × 1e6)
+RELOCATIONS = 6
+#: a corrector that moved the step less than this fraction of Δl from its (tangent)
+#: predictor stayed on the path (a turn below ~14°): a location failing there is the
+#: probes' trouble near a singular tangent, not another branch. The shallow arch's branch
+#: jump moved 0.57 Δl (33°); steps across its critical points at ×1 move < 0.02 Δl
+TRUST = 0.25
 #: a path is trivial in the measured dofs where the load moves them (‖δw_f‖ per unit load
 #: factor) by less than this fraction of the geometric arc length (:meth:`ArcLengthSolver._trivial`)
 TRIVIAL = 1e-12
@@ -177,6 +197,7 @@ class _Path:
     critical: list
     tried: list  # (Δl, why, residuals, detail) of the failed attempts at the next step
     switched: bool = False
+    turn: float = 0.0  # the corrector's move from the predictor / Δl in the step being taken
 
 
 class ArcLengthSolver:
@@ -241,6 +262,7 @@ class ArcLengthSolver:
         self.test = ScaledTest(self)
         self.counting = self.settings.inertia and not self.settings.follower
         self._fixed = False  # the step's corrector at a fixed load factor (a trivial path)
+        self.turn = 0.0  # of the last converged step: its corrector's move / Δl (_step)
         self._cached, self._prepared = None, False
 
         n_owned = (
@@ -419,7 +441,8 @@ class ArcLengthSolver:
                 floor/μ).
 
         Returns:
-            (Δw, Δλ, iterations, residuals); w and λ hold the new point.
+            (Δw, Δλ, iterations, residuals); w and λ hold the new point, and ``turn`` the
+            corrector's move from the predictor over Δl (0 at a fixed load factor).
         """
         s = self.settings
         self._fixed = False
@@ -432,6 +455,8 @@ class ArcLengthSolver:
         for it in range(s.max_iterations + 1):
             residuals.append(self._residual(lam_n + dlam))
             if self._converged(it, residuals[-1], lam_n + dlam, ddlam):
+                self.turn = 0.0 if fixed or not dl else self._moved(dw, dlam, dw0, dlam0) / dl
+                dw0.destroy()
                 return dw, dlam, it, tuple(residuals)
             if residuals[-1] > s.divergence * residuals[0]:
                 raise self._failed("DIVERGED_DTOL", "diverged", residuals)
@@ -456,6 +481,15 @@ class ArcLengthSolver:
         raise self._failed(
             "DIVERGED_MAX_IT", f"no convergence in {s.max_iterations} iterations", residuals
         )
+
+    def _moved(self, dw, dlam, dw0, dlam0):
+        """How far the corrector took the step (Δw, Δλ) from its predictor (Δw₀, Δλ₀), in
+        the arc-length metric."""
+        d = dw.copy()
+        d.axpy(-1.0, dw0)
+        moved = self._length(d, dlam - dlam0)
+        d.destroy()
+        return moved
 
     def _converged(self, it, fnorm, lam, ddlam):
         """Newton's convergence test (:class:`~beamfx.solvers.convergence.ScaledTest`) at
@@ -564,10 +598,8 @@ class ArcLengthSolver:
             if taken is None:
                 continue
             dw, dlam, its, res = taken
-            reached = target_load_factor is not None and (
-                (path.lam - target_load_factor) * (path.lam + dlam - target_load_factor) < 0
-                or path.lam + dlam == target_load_factor
-            )
+            path.turn = self.turn  # before a landing or the location's probes change it
+            reached = _crosses(path.lam, dlam, target_load_factor)
             if reached and path.lam + dlam != target_load_factor:
                 landed = self._land(saved, path.lam, dw, dlam, target_load_factor)
                 if landed:
@@ -576,8 +608,10 @@ class ArcLengthSolver:
             if self._jumped(path, saved, state, log):
                 dw.destroy()
                 continue
-            if self._accept(path, saved, (dw, dlam, its, res), state, on_step, log):
-                reached = False  # switched onto another branch before the step's end
+            outcome = self._accept(path, saved, (dw, dlam, its, res), state, on_step, log)
+            if outcome == "redo":
+                continue
+            reached = reached and outcome != "switched"  # a switch ends before the step's end
             if reached:
                 reason = "target"
                 break
@@ -666,8 +700,9 @@ class ArcLengthSolver:
     def _accept(self, path, saved, taken, state, on_step, log):
         """Record the converged step ``taken`` from the state ``saved``, with ``state`` =
         (inertia, forward) at its end; the critical point it passed (located, and the branch
-        switched, for a bifurcation). Returns whether the path switched branch (it no longer
-        ends where the step did)."""
+        switched, for a bifurcation). Returns "switched" when the path switched branch (it no
+        longer ends where the step did), "redo" when the step is to be redone shorter (its
+        critical point could not be located on it: state put back, Δl halved), else None."""
         dw, dlam, its, res = taken
         lam = path.lam + dlam
         count, forward = state
@@ -686,13 +721,15 @@ class ArcLengthSolver:
             switch = kind == "bifurcation" and self.settings.branch == "secondary"
             if kind == "limit" and abs(count - path.count) != 1:
                 path.critical.append(point)
-            elif self._bifurcation(
-                path, saved, taken, point, switch and not path.switched, on_step, log
-            ):
-                return True
+            else:
+                outcome = self._bifurcation(
+                    path, saved, taken, point, switch and not path.switched, on_step, log
+                )
+                if outcome:
+                    return outcome
         length = self._length(dw, dlam)
         self._record(path, (dw, dlam, its, res), length, count, forward, on_step, log)
-        return False
+        return None
 
     def _record(self, path, taken, length, count, forward, on_step, log, note=""):
         """Append the step ``taken`` (its end is the current state) and move the path on."""
@@ -746,8 +783,9 @@ class ArcLengthSolver:
     def _bifurcation(self, path, saved, taken, point, switch, on_step, log):
         """Locate the critical point (bifurcation or limit) the step ``taken`` passed; with
         ``switch``, record the located point and a first step along the secondary branch and
-        return True; else note the point, put the state back at the step's end and return
-        False."""
+        return "switched"; else note the point, put the state back at the step's end and
+        return None. A point that cannot be located: "redo" (:meth:`_unlocated`), or noted
+        after :data:`RELOCATIONS` halvings."""
         dw, dlam = taken[:2]
         t = time.perf_counter()
         end, lam_end, cached = self.w.vector.copy(), path.lam + dlam, self._cached
@@ -769,6 +807,11 @@ class ArcLengthSolver:
                     f"  {point.kind} point located at load factor {lam_c:.8g} ({n} solves; "
                     f"the inertia changes between {lo:.10g} and {hi:.10g})"
                 )
+        if x is None and self._unlocated(path, saved, point, log):
+            cached.destroy()
+            end.destroy()
+            dw.destroy()
+            return "redo"
         if x is None or not switch:
             path.critical.append(point)
             if x is not None:
@@ -776,7 +819,7 @@ class ArcLengthSolver:
             self._restore(end, lam_end)
             self._cached = cached
             end.destroy()
-            return False
+            return None
         cached.destroy()
         end.destroy()
         path.critical.append(point._replace(switched=True))
@@ -787,6 +830,21 @@ class ArcLengthSolver:
         located = (dw_c, lam_c - path.lam, 0, ())
         self._record(path, located, x, None, path.forward, on_step, log, "bifurcation point")
         self._switch(path, phi, dl, on_step, log)
+        return "switched"
+
+    def _unlocated(self, path, saved, point, log):
+        """After a failed location of ``point``: whether the step is to be redone with half
+        the arc length (at most :data:`RELOCATIONS` times in a row; the state is then put
+        back at its start). The eigenvalue that changed sign has its zero on a smooth path
+        between the step's ends, which the probes (steps from the start, shorter) reach;
+        when they do not and the corrector moved the step far from its predictor (more than
+        :data:`TRUST` Δl), the end is on another branch. Raises SolveFailed when Δl gets
+        too small."""
+        why = f"the {point.kind} point could not be located on the step: another branch"
+        if path.turn <= TRUST or sum(1 for t in path.tried if t[1] == why) >= RELOCATIONS:
+            return False
+        self._restore(saved, path.lam)
+        self._reject(path, (path.control.size, why, (), None), "branch jump", log)
         return True
 
     def _locate(self, path, saved, end, point):
@@ -914,6 +972,13 @@ class ArcLengthSolver:
 WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)
 #: how often a factorisation is retried with a larger workspace (ICNTL(14) times 4 each)
 WORKSPACE_RETRIES = 4
+
+
+def _crosses(lam, dlam, target):
+    """Whether the step from ``lam`` by ``dlam`` reaches or crosses ``target`` (None: no)."""
+    if target is None:
+        return False
+    return (lam - target) * (lam + dlam - target) < 0 or lam + dlam == target
 
 
 def _larger_workspace(ksp):
