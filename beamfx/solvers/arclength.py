@@ -586,9 +586,7 @@ class ArcLengthSolver:
             sign = math.copysign(1.0, target_load_factor - lam)
         count, forward = self._at_state(lam, sign)
         if arc_length is None:
-            t = self._cached
-            a = math.sqrt(self._dot(t, t) + self.settings.psi**2 * self.ff)
-            arc_length = abs(first_load_increment) * a
+            arc_length = self._first_arc_length(first_load_increment)
         path = _Path(lam, sign, count, forward, self._control(arc_length), [], [], [])
         saved = self.w.vector.copy()
         reason = "max_steps"
@@ -623,6 +621,12 @@ class ArcLengthSolver:
         self.lam.value = path.lam
         seconds = {**self.seconds, "total": time.perf_counter() - t_start}
         return ArcLengthResult(tuple(path.steps), reason, seconds, tuple(path.critical), count)
+
+    def _first_arc_length(self, load_increment):
+        """The Δl of a load increment ``load_increment`` along the linear tangent (cached at
+        the start state by :meth:`_at_state`)."""
+        t = self._cached
+        return abs(load_increment) * math.sqrt(self._dot(t, t) + self.settings.psi**2 * self.ff)
 
     def _control(self, dl0):
         """The step controller of Δl from the first arc length ``dl0``."""
