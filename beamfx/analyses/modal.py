@@ -15,6 +15,7 @@ import ufl
 from ..physics import coupled
 from ..physics.inertia import mass_form, point_mass_form
 from ..solvers.eigen import solve_eigen
+from ..solvers.eigen_shell import massless_rows, solve_eigen_massless
 from ..solvers.forms import compile_form
 
 
@@ -59,14 +60,18 @@ def assemble_pair(a, b, bcs):
 
 def is_symmetric(A, rtol=1e-9):
     """Whether ‖A − Aᵀ‖ ≤ rtol ‖A‖ (Frobenius). Collective."""
+    from petsc4py import PETSc
+
     D = A.copy()
-    D.axpy(-1.0, A.transpose())
+    At = A.transpose(PETSc.Mat())  # without ``out`` petsc4py transposes A in place
+    D.axpy(-1.0, At)
     ok = D.norm() <= rtol * A.norm()
-    D.destroy()
+    for obj in (D, At):
+        obj.destroy()
     return ok
 
 
-def free_shift(K, M):
+def free_shift(K, M, forces=None):
     """A small negative shift for target 0: a free structure has a singular K.
 
     min_i K_ii / M_ii (over rows with mass) bounds the lowest ω² from above (Rayleigh quotient
@@ -74,24 +79,49 @@ def free_shift(K, M):
     yet far above the round-off of the rigid-body eigenvalues. The mixed formulation's
     displacement rows have K_ii = 0 (their stiffness is the coupling to the force unknowns):
     there :func:`row_stiffness` stands for K_ii, which it equals for a positive definite K.
+    That coupling grows as the compliance 1/EA, 1/GA goes to 0 (the row's stiffness EA/h²),
+    while the lowest elastic ω² tends to the rigid limit's: the columns ``forces`` (global
+    indices of the force unknowns) do not count, and the scale is the rigid limit's,
+    independent of EA and GA; the full one only if that leaves no row with both stiffness and
+    mass (rotations without rotary inertia, at rest).
     """
-    k, m = row_stiffness(K), M.getDiagonal()
-    ma = m.getArray()
-    ratio = k[ma > 0] / ma[ma > 0]
-    ratio = ratio[ratio > 0]
-    local = np.min(ratio) if len(ratio) else np.inf
+    comm = K.getComm().tompi4py()
+    m = M.getDiagonal()
+    ma = m.getArray().copy()
     m.destroy()
-    return -1e-6 * K.getComm().tompi4py().allreduce(local, op=_mpi_min())
+    local = np.inf
+    for skip in (forces, None) if forces is not None else (None,):
+        k = row_stiffness(K, skip)
+        ratio = k[ma > 0] / ma[ma > 0]
+        ratio = ratio[ratio > 0]
+        local = comm.allreduce(np.min(ratio) if len(ratio) else np.inf, op=_mpi_min())
+        if np.isfinite(local):
+            break
+    return -1e-6 * local
 
 
-def row_stiffness(K):
-    """Per owned row i: max(|K_ii|, max_j K_ij² / |K_jj|) over the columns with K_jj ≠ 0. For a
-    positive semi-definite K that is K_ii (Cauchy–Schwarz); for a saddle-point tangent's rows
-    with a zero diagonal, the stiffness their coupling gives them. Collective."""
+def force_columns(model, K):
+    """Global indices (all ranks) of the mixed form's section force unknowns, or None."""
+    from .mixed import owned_force_dofs
+
+    owned = owned_force_dofs(model)
+    if owned is None:
+        return None
+    rows = np.asarray(owned, dtype=np.int64) + K.getOwnershipRange()[0]
+    return np.concatenate(K.getComm().tompi4py().allgather(rows))
+
+
+def row_stiffness(K, skip=None):
+    """Per owned row i: max(|K_ii|, max_j K_ij² / |K_jj|) over the columns with K_jj ≠ 0 (and
+    not in ``skip``, global indices). For a positive semi-definite K that is K_ii
+    (Cauchy–Schwarz); for a saddle-point tangent's rows with a zero diagonal, the stiffness
+    their coupling gives them. Collective."""
     comm = K.getComm().tompi4py()
     diag = K.getDiagonal()
     d = np.abs(np.concatenate(comm.allgather(diag.getArray().copy())))
     diag.destroy()
+    if skip is not None:
+        d[skip] = 0.0
     start = K.getOwnershipRange()[0]
     ai, aj, av = K.getValuesCSR()
     rows = np.repeat(np.arange(len(ai) - 1), np.diff(ai))
@@ -138,26 +168,64 @@ def solve_modes(
     t1 = time.perf_counter()
     K, M = assemble_pair(K_form, M_form, model.bcs)
     t2 = time.perf_counter()
+    mixed = getattr(model, "mixed", False)
     if shift is None and target == 0.0:
-        shift = free_shift(K, M)
-    pairs = solve_eigen(
-        K, M, n_modes, target, prefix, options, hermitian=is_symmetric(K), shift=shift
-    )
-    K.destroy()
-    M.destroy()
-    for x in pairs.vectors[n_modes:]:
-        x.destroy()
+        shift = free_shift(K, M, force_columns(model, K))
+    try:
+        if mixed:
+            pairs = _solve_mixed(K, M, n_modes, target if shift is None else shift, prefix, options)
+            modes = arrays_to_functions(model, pairs.vectors[:n_modes])
+        else:
+            pairs = solve_eigen(
+                K, M, n_modes, target, prefix, options, hermitian=is_symmetric(K), shift=shift
+            )
+            for x in pairs.vectors[n_modes:]:
+                x.destroy()
+            modes = to_functions(model, pairs.vectors[:n_modes])
+    finally:
+        K.destroy()
+        M.destroy()
     lam = pairs.values.real[:n_modes]
     omega = np.sign(lam) * np.sqrt(np.abs(lam))
     seconds = {"compile": t1 - t0, "assemble": t2 - t1, "solve": pairs.seconds}
-    return ModalResult(
-        lam,
-        omega,
-        omega / (2 * np.pi),
-        to_functions(model, pairs.vectors[:n_modes]),
-        pairs.residuals[:n_modes],
-        seconds,
-    )
+    return ModalResult(lam, omega, omega / (2 * np.pi), modes, pairs.residuals[:n_modes], seconds)
+
+
+def _solve_mixed(K, M, n_modes, shift, prefix, options):
+    """The mixed form's modes: the unknowns without mass (the section forces, and rotations
+    without rotary inertia) kept out of the Krylov space, K − σM factorised
+    (:func:`~beamfx.solvers.eigen_shell.solve_eigen_massless`). Shift-and-invert on the saddle
+    point holds them in it: as the compliance goes to 0 they become nearly defective infinite
+    eigenvalues and SLEPc converged 0 of 6 pairs (SM 2.10's blade, EA, GA × 1e8). The pairs
+    nearest σ, the ω² of the structure (real parts; a complex pair from a non-conservative
+    load keeps its real part, as :func:`solve_eigen` does).
+
+    A free shift (``free_shift``, σ < 0) can still exceed the spectrum wanted (rotations
+    without rotary inertia leave it the force coupling's scale, EA/h² per mass: at EA, GA ×
+    1e8 on SM 2.8, |σ| = 4e5 ω₁², the rigid modes at 1e-9 of ω₁² and the bending pair split by
+    5e-9): if |σ| is above the largest |ω²| found (and that is not the round-off of rigid
+    modes), the solve is repeated at −1e-6 of that."""
+    massless = massless_rows(M)
+    pairs = solve_eigen_massless(K, M, n_modes, prefix, massless, options, shift=float(shift))
+    top = float(np.max(np.abs(pairs.values[:n_modes].real)))
+    if shift < 0 and -shift > top > -1e-8 * shift:  # not if only rigid modes (round-off) came
+        again = solve_eigen_massless(K, M, n_modes, prefix, massless, options, shift=-1e-6 * top)
+        pairs = again._replace(seconds=pairs.seconds + again.seconds)
+    return pairs
+
+
+def arrays_to_functions(model, vectors):
+    """The eigenvectors (complex NumPy arrays, owned parts) as Functions ``mode_i`` on
+    ``model.W`` (their real parts)."""
+    from dolfinx import fem
+
+    modes = []
+    for i, x in enumerate(vectors):
+        f = fem.Function(model.W, name=f"mode_{i}")
+        f.vector.array[:] = np.real(x)
+        f.x.scatter_forward()
+        modes.append(f)
+    return tuple(modes)
 
 
 def effective_masses(model, modes, rotary="full"):

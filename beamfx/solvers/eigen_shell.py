@@ -201,14 +201,46 @@ def backward_errors(K, terms, values, vectors):
     return np.asarray(out)
 
 
-def solve_eigen_massless(K, M, nev, prefix, massless, options=None):
-    """The ``nev`` eigenpairs of K x = θ M x nearest 0 with the ``massless`` unknowns (local
-    indices; M is zero on their rows and columns) kept out of the Krylov space (module doc).
+def massless_rows(M):
+    """Owned local indices whose row and column of M are zero (no mass: the force unknowns of a
+    mixed form, rotations without rotary inertia, hinges, constrained rows). Collective."""
+    from petsc4py import PETSc
+
+    Mt = M.transpose(PETSc.Mat())  # without ``out`` petsc4py transposes M in place
+    zero = []
+    for A in (M, Mt):
+        ai, _, av = A.getValuesCSR()
+        nonzero = np.add.reduceat(np.abs(np.r_[av, 0.0]), ai[:-1]) * (np.diff(ai) > 0)
+        zero.append(nonzero == 0.0)
+    Mt.destroy()
+    return np.flatnonzero(zero[0] & zero[1]).astype(np.int32)
+
+
+def solve_eigen_massless(K, M, nev, prefix, massless, options=None, shift=0.0):
+    """The ``nev`` eigenpairs of K x = θ M x nearest ``shift`` with the ``massless`` unknowns
+    (local indices; M is zero on their rows and columns) kept out of the Krylov space (module
+    doc). A nonzero ``shift`` σ factorises K − σ M instead of K (a free structure's K is
+    singular: σ < 0 below its rigid-body modes at 0) and adds σ back to the eigenvalues.
 
     Returns:
         :class:`~beamfx.solvers.eigen.EigenPairs`; its vectors are complex NumPy arrays
-        (local parts, massless part completed), nearest 0 first.
+        (local parts, massless part completed), nearest ``shift`` first; residuals are the
+        backward errors of the shifted problem.
     """
+    t = time.perf_counter()
+    if shift:
+        K = K.copy()
+        K.axpy(-shift, M)
+    try:
+        pairs = _eigen_massless(K, M, nev, prefix, massless, options)
+    finally:
+        if shift:
+            K.destroy()
+    return pairs._replace(values=pairs.values + shift, seconds=time.perf_counter() - t)
+
+
+def _eigen_massless(K, M, nev, prefix, massless, options):
+    """:func:`solve_eigen_massless` at shift 0."""
     t = time.perf_counter()
     op = _Inverse(K, M, prefix, massless)
     try:
