@@ -71,7 +71,7 @@ def is_symmetric(A, rtol=1e-9):
     return ok
 
 
-def free_shift(K, M, forces=None):
+def free_shift(K, M, forces=None, length=None):
     """A small negative shift for target 0: a free structure has a singular K.
 
     min_i K_ii / M_ii (over rows with mass) bounds the lowest ω² from above (Rayleigh quotient
@@ -82,22 +82,53 @@ def free_shift(K, M, forces=None):
     That coupling grows as the compliance 1/EA, 1/GA goes to 0 (the row's stiffness EA/h²),
     while the lowest elastic ω² tends to the rigid limit's: the columns ``forces`` (global
     indices of the force unknowns) do not count, and the scale is the rigid limit's,
-    independent of EA and GA; the full one only if that leaves no row with both stiffness and
-    mass (rotations without rotary inertia, at rest).
+    independent of EA and GA. If that leaves no row with both stiffness and mass (rotations
+    without rotary inertia, at rest), :func:`bending_scale` with the shortest cell ``length``.
     """
     comm = K.getComm().tompi4py()
     m = M.getDiagonal()
     ma = m.getArray().copy()
     m.destroy()
     local = np.inf
-    for skip in (forces, None) if forces is not None else (None,):
-        k = row_stiffness(K, skip)
-        ratio = k[ma > 0] / ma[ma > 0]
-        ratio = ratio[ratio > 0]
-        local = comm.allreduce(np.min(ratio) if len(ratio) else np.inf, op=_mpi_min())
-        if np.isfinite(local):
-            break
+    if forces is not None:
+        local = _min_ratio(comm, row_stiffness(K, forces), ma)
+        if not np.isfinite(local) and length is not None:
+            local = bending_scale(K, ma, forces, length)
+    if not np.isfinite(local):
+        local = _min_ratio(comm, row_stiffness(K), ma)
     return -1e-6 * local
+
+
+def _min_ratio(comm, k, m):
+    """The smallest k_i / m_i over the rows with mass and stiffness (all ranks; inf if none)."""
+    ratio = k[m > 0] / m[m > 0]
+    ratio = ratio[ratio > 0]
+    return comm.allreduce(np.min(ratio) if len(ratio) else np.inf, op=_mpi_min())
+
+
+def bending_scale(K, m, forces, length):
+    """The rigid limit's bending scale EI/(ρA h⁴) from the matrices: the smallest diagonal of
+    the rows with stiffness but no mass (rotations without rotary inertia: EI/h; not the
+    ``forces``, not the constrained rows, identity rows) over the largest diagonal mass (ρA h)
+    times ``length``² (h). In the rigid limit a translation moves with the rotations; this
+    is the highest bending ω² of the mesh, so 1e-6 of it lies below the lowest elastic ω² of
+    any mesh one would run. Collective."""
+    comm = K.getComm().tompi4py()
+    start = K.getOwnershipRange()[0]
+    ai, aj, av = K.getValuesCSR()
+    rows = np.repeat(np.arange(len(ai) - 1), np.diff(ai))
+    diagonal = aj == rows + start
+    d = np.zeros(len(ai) - 1)
+    d[rows[diagonal]] = av[diagonal]
+    coupled = np.zeros(len(ai) - 1, dtype=bool)
+    coupled[rows[~diagonal & (av != 0.0)]] = True
+    owned = np.ones(len(ai) - 1, dtype=bool)
+    local_forces = forces - start
+    owned[local_forces[(local_forces >= 0) & (local_forces < len(owned))]] = False
+    keep = owned & coupled & (d > 0) & (m == 0)
+    k = comm.allreduce(np.min(d[keep]) if keep.any() else np.inf, op=_mpi_min())
+    top = comm.allreduce(float(np.max(m, initial=0.0)), op=_mpi_max())
+    return k / (top * length**2) if top > 0 else np.inf
 
 
 def force_columns(model, K):
@@ -138,6 +169,12 @@ def _mpi_min():
     return MPI.MIN
 
 
+def _mpi_max():
+    from mpi4py import MPI
+
+    return MPI.MAX
+
+
 def to_functions(model, vectors):
     """The eigenvectors (PETSc Vec, destroyed here) as Functions ``mode_i`` on ``model.W``."""
     from dolfinx import fem
@@ -170,7 +207,8 @@ def solve_modes(
     t2 = time.perf_counter()
     mixed = getattr(model, "mixed", False)
     if shift is None and target == 0.0:
-        shift = free_shift(K, M, force_columns(model, K))
+        length = model.discretisation.min_cell_length() if mixed else None
+        shift = free_shift(K, M, force_columns(model, K), length)
     try:
         if mixed:
             pairs = _solve_mixed(K, M, n_modes, target if shift is None else shift, prefix, options)
@@ -200,11 +238,8 @@ def _solve_mixed(K, M, n_modes, shift, prefix, options):
     nearest σ, the ω² of the structure (real parts; a complex pair from a non-conservative
     load keeps its real part, as :func:`solve_eigen` does).
 
-    A free shift (``free_shift``, σ < 0) can still exceed the spectrum wanted (rotations
-    without rotary inertia leave it the force coupling's scale, EA/h² per mass: at EA, GA ×
-    1e8 on SM 2.8, |σ| = 4e5 ω₁², the rigid modes at 1e-9 of ω₁² and the bending pair split by
-    5e-9): if |σ| is above the largest |ω²| found (and that is not the round-off of rigid
-    modes), the solve is repeated at −1e-6 of that."""
+    Should a free shift σ < 0 exceed the spectrum found (a slow, fragile solve), it is
+    repeated at −1e-6 of the largest |ω²| found, unless those are rigid modes' round-off."""
     massless = massless_rows(M)
     pairs = solve_eigen_massless(K, M, n_modes, prefix, massless, options, shift=float(shift))
     top = float(np.max(np.abs(pairs.values[:n_modes].real)))

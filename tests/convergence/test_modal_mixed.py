@@ -63,8 +63,9 @@ def test_stiff_free_free_beam(rotary, rigid):
     """SM 2.8's free-free Timoshenko beam (4 × P3) in the mixed form with EA, GA × 1e8: its
     rigid-body modes at ~0 (|ω| ≤ 1e-4 of the lowest elastic one, as the ×1 comparison in
     test_mixed.py; without rotary inertia the rotation about the axis has no mass: five)
-    and its elastic modes on their trend. Without rotary inertia the free shift is the force
-    coupling's scale, 4e5 ω₁² here: the solve is repeated at a shift below the found modes."""
+    and its elastic modes on their trend. Without rotary inertia no row has both mass and a
+    stiffness of the rigid limit: the free shift comes from the bending scale EI/(ρA h⁴)
+    (the force coupling's, EA/h² per mass, was 4e5 ω₁² here)."""
     spec = sme._free_free_timoshenko(4, 3)[0][0].model
     at = {f: _modes(spec, f, "mixed", 12, rotary)[0] for f in (1.0, 1e2, 1e8)}
     for omega in at.values():
