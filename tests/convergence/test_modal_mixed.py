@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from mpi4py import MPI
 
 from beamfx.analyses.mixed import choose_formulation
 from beamfx.analyses.modal import solve_modes
@@ -96,6 +97,7 @@ dir = "OUT"
 """
 
 
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="a scene in each rank's own tmp_path")
 def test_free_stiff_rod_scene_keeps_its_rigid_modes(tmp_path, scene_file):
     """A free rod with EA L²/EI = 8e9 through ``beamfx run`` ("auto": the mixed form), no
     rotary inertia: five rigid-body modes (the rotation about the axis has no mass), labelled,
