@@ -21,6 +21,8 @@ x' = R(t0 + Λ0 Γ) cell by cell (:meth:`sync`, exact to quadrature); the sectio
 statically determined one, in section axes Λ0ᵀRᵀn.
 """
 
+from functools import cached_property
+
 import numpy as np
 import ufl
 from mpi4py import MPI
@@ -266,7 +268,6 @@ class CondensedModel(Discretised):
         self.F = ufl.derivative(Pi, g, v) - self.load_factor * moments
         self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.W))
         self.work = None  # the residual is not linear in the load factor (arc length: no)
-        self.x_dot = rod.position_rate(R, n, self.t_s, d.Lam0, self.compliance)
         # follower forces: ∂(residual)/∂(force at the point), for the tangent's coupling term
         self._followers = [
             (
@@ -277,6 +278,15 @@ class CondensedModel(Discretised):
             )
             for F, f0, at, before in followers
         ]
+
+    @cached_property
+    def x_dot(self):
+        """x' = R(t_s + Λ0 Γ) (UFL, global axes): the follower forces' coupling and the
+        centre line by quadrature; built where used (the closed-form centre line of the
+        planar model needs none)."""
+        n = self.load_factor * self.section_force()
+        d = self.discretisation
+        return rod.position_rate(self.rotation_of(self.w), n, self.t_s, d.Lam0, self.compliance)
 
     # --- state ------------------------------------------------------------------------------
 
