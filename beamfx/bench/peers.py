@@ -136,12 +136,15 @@ def export(out_dir):
     return data
 
 
-def run_beamfx(out_dir, log=print):
-    """Run beamfx on every problem through :func:`.run.run_case`; write ``beamfx.json``."""
+def run_beamfx(out_dir, log=print, problems=None):
+    """Run beamfx on every problem (or those named in ``problems``) through
+    :func:`.run.run_case`; write ``beamfx.json``."""
     from .run import run_case
 
     records, refs = [], {}
     for pid, case in _cases().items():
+        if problems and pid not in problems:
+            continue
         if log:
             log(f"beamfx {pid}: {case.id}")
         result = run_case(case, log)
@@ -168,6 +171,7 @@ def run_beamfx(out_dir, log=print):
                     "first_s": row["wall_s_cold"],
                     "wall_s": row["wall_s_warm"],
                     "process_s": row.get("wall_s_process"),
+                    "whole_split": row.get("whole_split"),  # the warm run's own split
                     "error": row["error"],
                     "values": row["values"],
                     "is_reference": finest and i == len(result["rows"]) - 1,
@@ -268,16 +272,25 @@ def merge(peer_dir, report_dir, run=True, log=print):
 
 
 def main(argv=None):
-    """Command line: ``export DIR``, ``beamfx DIR`` or ``DIR REPORT_DIR [--no-run]``."""
+    """Command line: ``export DIR``, ``beamfx DIR [PROBLEM ...]`` (beamfx's side alone, of
+    the problems named) or ``DIR REPORT_DIR [--no-run]``."""
     argv = list(sys.argv[1:] if argv is None else argv)
     usage = (
-        "usage: python -m beamfx.bench.peers export DIR | beamfx DIR | DIR REPORT_DIR [--no-run]"
+        "usage: python -m beamfx.bench.peers export DIR | beamfx DIR [PROBLEM ...] | "
+        "DIR REPORT_DIR [--no-run]"
     )
     if len(argv) == 2 and argv[0] == "export":
         export(argv[1])
-    elif len(argv) == 2 and argv[0] == "beamfx":
+    elif len(argv) >= 2 and argv[0] == "beamfx":
+        unknown = set(argv[2:]) - set(PROBLEMS)
+        if unknown:
+            raise SystemExit(f"unknown problems {sorted(unknown)}; known: {list(PROBLEMS)}")
         t0 = time.perf_counter()
-        run_beamfx(argv[1])
+        records, _ = run_beamfx(argv[1], problems=argv[2:])
+        for r in records:
+            print(
+                f"{r['problem']} {r['setting']}: whole {r['whole_s']:.4f} s, solve {r['wall_s']:.5f} s"
+            )
         print(f"beamfx: {time.perf_counter() - t0:.1f} s")
     elif len(argv) in (2, 3) and argv[0] not in ("export", "beamfx"):
         merge(argv[0], argv[1], run="--no-run" not in argv)
