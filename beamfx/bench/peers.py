@@ -172,6 +172,7 @@ def run_beamfx(out_dir, log=print, problems=None):
                     "wall_s": row["wall_s_warm"],
                     "process_s": row.get("wall_s_process"),
                     "whole_split": row.get("whole_split"),  # the warm run's own split
+                    "load_steps": row.get("load_steps"),
                     "error": row["error"],
                     "values": row["values"],
                     "is_reference": finest and i == len(result["rows"]) - 1,
@@ -238,6 +239,30 @@ def measure_processes(records, problems, log=print):
     return measured
 
 
+def measure_stack(records, problems, log=print):
+    """The stack's fixed costs (:func:`.peers_stack.stack_costs`) of the beamfx setting that
+    reaches the target where beamfx is not ahead on whole runs (a P1 setting), where not yet
+    measured: the why-line's floor; returns how many were measured."""
+    from . import all_cases
+    from .peers_stack import stack_costs
+
+    measured = 0
+    for pid, meta in problems.items():
+        s = summary(records, pid)
+        fx = s["beamfx_at_target"]
+        if s["beamfx_ahead"] or fx is None or fx.get("stack_s") is not None:
+            continue
+        setting = fx.get("case_setting") or []
+        if len(setting) != 2 or setting[1] != 1:
+            continue
+        fx["stack_s"] = stack_costs(all_cases()[meta["beamfx_case"]], setting)
+        measured += 1
+        if log:
+            parts = ", ".join(f"{k} {v:.2e}" for k, v in fx["stack_s"].items())
+            log(f"beamfx {pid} {fx['setting']}: stack costs (s) {parts}")
+    return measured
+
+
 def merge(peer_dir, report_dir, run=True, log=print):
     """Write the peer report: beamfx records (run now, or read from ``peer_dir/beamfx.json``)
     + peer records -> ``report_dir/peers.md``, ``peers.json`` and one ``peers_<problem>.png``
@@ -255,7 +280,8 @@ def merge(peer_dir, report_dir, run=True, log=print):
     notes = NOTES | (json.loads(notes_file.read_text()) if notes_file.exists() else {})
     for pid, text in load_peer_notes(peer_dir).items():
         notes[pid] = f"{notes[pid]} {text}" if pid in notes else text
-    if measure_processes(records, problems, log):  # kept for a later --no-run merge
+    measured = measure_processes(records, problems, log) + measure_stack(records, problems, log)
+    if measured:  # kept for a later --no-run merge
         (peer_dir / "beamfx.json").write_text(json.dumps({"references": refs, "records": fx}))
     report.mkdir(parents=True, exist_ok=True)
     for pid, meta in problems.items():

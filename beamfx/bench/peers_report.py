@@ -244,9 +244,28 @@ def whole_split_text(fx):
         )
     rest = whole - sum(v for _, v in parts)
     items = ", ".join(f"{label} {_g(v)}" for label, v in parts)
-    return (
+    text = (
         f"beamfx's whole run, measured (s): {items}, the rest (load stepping, folder, log, "
         f"results.json) {_g(rest)}."
+    )
+    return text + (f" {stack_text(fx)}" if fx.get("stack_s") else "")
+
+
+def stack_text(fx):
+    """The stack's fixed costs of ``fx`` (:func:`.peers_stack.stack_costs`), as a sentence
+    with the floor they make for its run: a mesh, 5 spaces, the forms, the expression, the
+    solve and one frame per load step (the frames of ``whole_split``, per its steps)."""
+    c, steps = fx["stack_s"], fx.get("load_steps")
+    floor = c["mesh"] + 5 * c["space"] + c["forms"] + c["expression"] + (fx.get("wall_s") or 0)
+    frames = f", one frame {_g(c['frame'])}"
+    if steps:
+        floor += steps * c["frame"]
+        frames += f" (x {steps} load steps)"
+    return (
+        f"The stack's fixed costs, each measured alone (s): a DOLFINx mesh {_g(c['mesh'])}, a "
+        f"function space {_g(c['space'])} (the model makes 5), residual and tangent from the "
+        f"JIT cache {_g(c['forms'])}, the section expression {_g(c['expression'])}{frames}: "
+        f"with the solve, a floor of {_g(floor)} s for this run."
     )
 
 
