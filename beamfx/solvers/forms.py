@@ -152,7 +152,7 @@ def _lazy_form_constants():
     Form = uf.Form
     if getattr(Form.constants, "beamfx_lazy", False):
         return
-    renumbering = Form._compute_renumbering
+    renumbering, original = Form._compute_renumbering, Form.__init__
 
     def __init__(self, integrals):  # UFL's, but for the constants
         if not all(isinstance(itg, uf.Integral) for itg in integrals):
@@ -182,7 +182,7 @@ def _lazy_form_constants():
         _listed(self)
         return renumbering(self)
 
-    constants.beamfx_lazy = True
+    constants.beamfx_lazy, __init__.original = True, original
     Form.__init__, Form.constants, Form.constant_numbering = __init__, constants, constant_numbering
     Form._compute_renumbering = _compute_renumbering
 
