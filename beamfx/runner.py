@@ -33,7 +33,9 @@ class RunResult:
     result: "Result"  # the analysis's Result
     model: dict  # beams, degree, unknowns, kinematics, trimming, condensed
     probes: dict  # {probe name: values at the final state}
-    wall_time_s: dict  # the analysis's split, and "run": the whole run in-process
+    wall_time_s: dict  # the analysis's split, "model" (its build, the frame writer's set-up),
+    # "output_probes"/"_reactions"/"_frames" (per step, outside the analysis's own split), and
+    # "run": the whole run in-process
     paraview: dict  # the files written for ParaView
     accuracy: dict | None = None  # the [accuracy] refinement, if asked
     pictures: dict | None = None  # the pictures rendered, if asked
@@ -110,16 +112,20 @@ def run_scene(
     log(f"beamfx: {path} -> {out}/")
     with claim(out, comm, path, restart, log):  # locked, an earlier run's files removed
         scene, refinement = _refine(scene, comm, log)
+        t_model = time.perf_counter()
         ctx = _context(scene, out, comm, log, restart, png or animate)
+        t_model = time.perf_counter() - t_model
         result = _analyse(analysis(scene.analysis), scene, ctx, log)
         ctx.frames.close()
         ctx.close()
+        output = {f"output_{k}": v for k, v in ctx.seconds.items()}
+        seconds = {**result.seconds, "model": t_model, **output}
         run = RunResult(
             str(path),
             result,
             _model_entry(scene, ctx),
             _final_probes(scene, ctx),
-            {**result.seconds, "run": time.perf_counter() - t_start},
+            {**seconds, "run": time.perf_counter() - t_start},
             ctx.frames.files(),
             refinement.entry(scene.accuracy) if refinement else None,
             reactions=_reactions(ctx),

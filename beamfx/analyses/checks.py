@@ -51,6 +51,8 @@ def end_contacts(model, rtol=1e-8):
     beams in closed form with numpy, the others one by one (:func:`closest_arc_length`, which
     also gives the arc length of every contact inside a span, where a T-joint puts a vertex).
     """
+    if len(model.beams) < 2:  # one beam: no end of another on it (and no k-d tree to build)
+        return []
     tol = rtol * model_size(model)
     lo, hi = _boxes(model, tol)
     ends = np.vstack([a.curve.points([0.0, a.curve.length]) for a in model.beams])

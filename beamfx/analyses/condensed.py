@@ -21,6 +21,8 @@ x' = R(t0 + Λ0 Γ) cell by cell (:meth:`sync`, exact to quadrature); the sectio
 statically determined one, in section axes Λ0ᵀRᵀn.
 """
 
+from functools import cached_property
+
 import numpy as np
 import ufl
 from mpi4py import MPI
@@ -187,7 +189,7 @@ class CondensedModel(Discretised):
         zero = np.zeros(bs) if bs > 1 else PETSc.ScalarType(0.0)
         self.bcs = [fem.dirichletbc(zero, clamp, self.W)]
         self.coupling = FollowerCoupling(self, self._followers) if self._followers else None
-        self._integrator = None
+        self._integrator = self._chain_data = None
         self._synced = None  # (load factor, w) that ``u`` was last integrated from
 
     # --- the rotation parametrisation (hooks) -----------------------------------------------
@@ -266,7 +268,6 @@ class CondensedModel(Discretised):
         self.F = ufl.derivative(Pi, g, v) - self.load_factor * moments
         self.J = ufl.derivative(self.F, g, ufl.TrialFunction(self.W))
         self.work = None  # the residual is not linear in the load factor (arc length: no)
-        self.x_dot = rod.position_rate(R, n, self.t_s, d.Lam0, self.compliance)
         # follower forces: ∂(residual)/∂(force at the point), for the tangent's coupling term
         self._followers = [
             (
@@ -277,6 +278,15 @@ class CondensedModel(Discretised):
             )
             for F, f0, at, before in followers
         ]
+
+    @cached_property
+    def x_dot(self):
+        """The centre line's x' = R(t_s + Λ0 Γ) (UFL, global axes), for the follower forces'
+        coupling and the centre line by quadrature; built where used (the closed-form centre
+        line of the planar model needs none)."""
+        n = self.load_factor * self.section_force()
+        d = self.discretisation
+        return rod.position_rate(self.rotation_of(self.w), n, self.t_s, d.Lam0, self.compliance)
 
     # --- state ------------------------------------------------------------------------------
 
@@ -369,6 +379,23 @@ class CondensedModel(Discretised):
         )
         return same if self.comm.size == 1 else self.comm.allreduce(same, op=MPI.LAND)
 
+    def _chain(self):
+        """What :meth:`sync` needs of the mesh, found once (the geometry does not change):
+        the local cells' count, their flips, the node at vertex 1, the order of all cells
+        along the beam (their s_a over all ranks, sorted), this rank's offset in it, and the
+        dofs of ``u`` per local cell. Collective the first time."""
+        if self._chain_data is None:
+            m, xi = self.mesh.mesh, self._xi
+            n = m.topology.index_map(1).size_local
+            s_a = self._s_ends[:n].min(axis=1)
+            parts = self.comm.allgather(s_a) if self.comm.size > 1 else [s_a]
+            order = np.argsort(np.concatenate(parts), kind="stable")
+            offset = sum(len(p) for p in parts[: self.comm.rank])
+            one = int(np.argmin(np.abs(xi - 1.0)))  # the node at vertex 1
+            dofs = self.u.function_space.dofmap.list.array.reshape(-1, len(xi))[:n]
+            self._chain_data = (n, self._flipped[:n], one, order, offset, dofs.ravel())
+        return self._chain_data
+
     def sync(self):
         """Integrate the displacement u = ∫ (x' − t0) ds from the clamp into ``self.u``.
 
@@ -382,27 +409,17 @@ class CondensedModel(Discretised):
         if self._in_sync():
             return
         stamp = (float(self.load_factor.value), self.w.x.array.copy())
-        V, m, xi = self.u.function_space, self.mesh.mesh, self._xi
         if self.coupling:  # follower forces from the converged rotations
             self.coupling.update()
-        inc = self._increments(xi)
-        n = m.topology.index_map(1).size_local
-        s_a = self._s_ends[:n].min(axis=1)
-        flipped = self._flipped[:n]
-        one = int(np.argmin(np.abs(xi - 1.0)))  # the node at vertex 1
+        inc = self._increments(self._xi)
+        n, flipped, one, order, offset, dofs = self._chain()
         step = np.where(flipped[:, None], -inc[:, one], inc[:, one])  # from s_a to s_b
         # one rank: its own part (an allgather pickles it: a third of this call's time)
-        parts = self.comm.allgather((s_a, step)) if self.comm.size > 1 else [(s_a, step)]
-        offset = sum(len(p[0]) for p in parts[: self.comm.rank])
-        s_all = np.concatenate([p[0] for p in parts])
-        order = np.argsort(s_all, kind="stable")
-        at_s_a = np.zeros((len(s_all), 3))
-        at_s_a[order] = np.cumsum(
-            np.vstack([np.zeros(3), np.concatenate([p[1] for p in parts])[order][:-1]]), axis=0
-        )
+        steps = np.concatenate(self.comm.allgather(step)) if self.comm.size > 1 else step
+        at_s_a = np.zeros((len(steps), 3))
+        at_s_a[order] = np.cumsum(np.vstack([np.zeros(3), steps[order][:-1]]), axis=0)
         mine = at_s_a[offset : offset + n]
         u_v0 = mine + np.where(flipped[:, None], step, 0.0)
-        dofs = V.dofmap.list.array.reshape(-1, len(xi))[:n]
-        self.u.x.array.reshape(-1, 3)[dofs.ravel()] = (u_v0[:, None, :] + inc).reshape(-1, 3)
+        self.u.x.array.reshape(-1, 3)[dofs] = (u_v0[:, None, :] + inc).reshape(-1, 3)
         self.u.x.scatter_forward()
         self._synced = stamp

@@ -1,6 +1,7 @@
 """What an analysis needs from the run besides its model and settings: where to write, what
 to report, how to solve. One :class:`RunContext` per ``beamfx run``."""
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +44,9 @@ class RunContext:
     _points: list | None = field(default=None, init=False, repr=False)  # the probes' points
     latest_reactions: dict | None = None  # results.json entries of the last reactions
     _reaction_csv: object = field(default=None, init=False, repr=False)  # reactions.csv
+    #: wall time (s) of the per-step output of :meth:`step` and :meth:`last_frame`: probes (the
+    #: first evaluation loads the section expression), reactions (with reactions.csv), frames
+    seconds: dict = field(default_factory=lambda: dict.fromkeys(OUTPUT_PARTS, 0.0))
 
     def reactions(self, model):
         """Support reactions and their balance with the loads at the model's current state
@@ -68,11 +72,19 @@ class RunContext:
 
     def step(self, model, step, time):
         """After an accepted step (static, arc length): probes tracked, the reactions (a row
-        of ``reactions.csv``), and a frame where the output asks."""
+        of ``reactions.csv``), and a frame where the output asks (each timed in
+        :attr:`seconds`)."""
+        t0 = _now()
         self.probe_values(model)
+        t1 = _now()
         self.reaction_row(step, time, self.reactions(model))
+        t2 = _now()
         if self.frames.want(step, time):
             self.frames.write(step, time, self.latest_reactions["reactions"])
+        seconds = self.seconds
+        seconds["probes"] += t1 - t0
+        seconds["reactions"] += t2 - t1
+        seconds["frames"] += _now() - t2
 
     def reaction_row(self, step, time, entry):
         """A row of ``reactions.csv`` (the transient's columns without the inertia; ``time``:
@@ -110,7 +122,9 @@ class RunContext:
         if reactions is None and self.latest_reactions is not None:
             reactions = self.latest_reactions["reactions"]
         if self.frames.want(step, time, last=True):
+            t0 = _now()
             self.frames.write(step, time, reactions)
+            self.seconds["frames"] += _now() - t0
 
     def fallback(self):
         """The full model instead of the condensed one: the failed attempt's probes and frames
@@ -123,4 +137,9 @@ class RunContext:
         return self.model
 
 
-__all__ = ["RunContext"]
+#: the parts of :attr:`RunContext.seconds`
+OUTPUT_PARTS = ("probes", "reactions", "frames")
+_now = time.perf_counter
+
+
+__all__ = ["OUTPUT_PARTS", "RunContext"]

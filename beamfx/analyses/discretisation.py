@@ -16,6 +16,8 @@ with p + 1 (``dx``, exact to 2p).
 
 import weakref
 from dataclasses import dataclass
+from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 import ufl
@@ -110,7 +112,8 @@ def cell_arc_lengths(spec, mesh, X):
 def _section_fields(spec, mesh, comm):
     """Stiffness (EA, GA_y, GA_z, GJ, EI_y, EI_z) and inertia (rho_A, rho_I) fields, the
     shear-rigid/inextensible limits of ``spec.kinematics`` applied; and the largest EA or GA
-    before the limits (over all ranks)."""
+    before the limits (over all ranks). The inertia field as a :class:`Deferred` (its values
+    computed, its space made at first use)."""
     kin, beams, cb = spec.kinematics, spec.beams, mesh.cell_beam
     varies = any(b.section.varies for b in beams)
     q = mesh.degree if varies else 0
@@ -134,7 +137,7 @@ def _section_fields(spec, mesh, comm):
         raise ValueError("a section stiffness is not positive somewhere along a beam")
     raw_max = comm.allreduce(raw_max, op=MPI.MAX)
     m = mesh.mesh
-    return cell_field(m, q, stiff), cell_field(m, q, mass), raw_max
+    return cell_field(m, q, stiff), Deferred(partial(cell_field, m, q, mass)), raw_max
 
 
 def _section_rows(kin):
@@ -248,7 +251,7 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         raised_degree=[b.name for b in spec.beams if b.degree < p],
         named=named,
         stiffness=stiffness,
-        inertia=inertia,
+        mass=inertia,
         stiffness_scale=raw_max,
         reference=reference,
         twist=twist,
@@ -260,6 +263,12 @@ def discretise(spec, comm=MPI.COMM_WORLD, extra_points=()):
         dx=ufl.dx(domain=m, metadata={"quadrature_degree": 2 * p}),
         matrices=matrices,
     )
+
+
+class Deferred(NamedTuple):
+    """A field made when first read: ``make()`` returns it (collective)."""
+
+    make: object
 
 
 @dataclass(frozen=True, eq=False)
@@ -277,7 +286,7 @@ class Discretisation:
     raised_degree: list  #: names of the beams raised to ``degree`` (one degree per mesh)
     named: dict  #: {point name: (beam index, arc length, xyz)} of every vertex-named point
     stiffness: object  #: DG Function (EA, GA_y, GA_z, GJ, EI_y, EI_z), limits applied
-    inertia: object  #: DG Function (ρA, ρI_1, ρI_2, ρI_3)
+    mass: object  #: the :attr:`inertia` Function, or a :class:`Deferred` that makes it
     stiffness_scale: float  #: largest EA, GA_y or GA_z before the limits (all ranks)
     reference: object  #: DG0 Function: orientation vector of each cell (global axes)
     twist: object  #: DG0 Function: twist of each cell (radians); DG_p if it varies along a beam
@@ -288,6 +297,15 @@ class Discretisation:
     dx_shear: object  #: measure of the shear and axial energy (degree 2p − 1)
     dx: object  #: measure of everything else (degree 2p)
     matrices: object = None  #: :class:`SectionMatrices`, or None: every section is diagonal
+
+    @property
+    def inertia(self):
+        """DG Function (ρA, ρI_1, ρI_2, ρI_3), made at first use where deferred (a static
+        analysis reads no inertia, and its space costs a JIT look-up and a dofmap). Collective
+        at that first use, which every rank makes (mass checks, mass forms, gravity)."""
+        if isinstance(self.mass, Deferred):
+            object.__setattr__(self, "mass", self.mass.make())
+        return self.mass
 
     def strain_energy(self, Gamma, K, scale=None, dx=None):
         """The strain energy of the sections (times ``scale``, e.g. a damping time, if given):

@@ -117,7 +117,7 @@ class PlanarCondensedModel(CondensedModel):
             raise ValueError("the planar condensed model needs a planar model (kinematics.plane)")
         self.normal = plane_normal(model.kinematics)
         self._n = np.eye(3)[PLANES[model.kinematics.plane][2]]
-        self._cell_data = None
+        self._cell_data = self._closed = self._end_data = None
         super().__init__(model, comm, extra_points)
 
     # --- the rotation parametrisation -------------------------------------------------------
@@ -210,22 +210,34 @@ class PlanarCondensedModel(CondensedModel):
         """u(node) − u(vertex 0) per local cell: closed form where θ is linear in a straight
         cell (:meth:`closed_form`), else composite Gauss with parts of at most
         :data:`SUBINTERVAL_ANGLE` of turn."""
-        n_cells = self.mesh.mesh.topology.index_map(1).size_local
-        theta = self.w.x.array[self.W.dofmap.list.array.reshape(-1, len(xi))[:n_cells]]
-        if not self.closed_form():
+        if self._closed is None:  # the sections and the degree do not change
+            self._closed = self.closed_form()
+        if not self._closed:
+            n_cells = self.mesh.mesh.topology.index_map(1).size_local
+            theta = self.w.x.array[self.W.dofmap.list.array.reshape(-1, len(xi))[:n_cells]]
             turn = float(np.ptp(theta, axis=1).max(initial=0.0)) if n_cells else 0.0
             turn = self.comm.allreduce(turn, op=MPI.MAX)
             parts = 2 ** int(np.ceil(np.log2(max(1.0, turn / SUBINTERVAL_ANGLE))))
             return self._quadrature_increments(xi, parts)
         cells, c, h, sign, block, force = self._data()
-        n_global = force.eval(cells).reshape(-1, 3) if force else np.zeros((len(cells), 3))
-        n = plane_complex(n_global, self.kin.plane)
-        i0, i1 = int(np.argmin(xi)), int(np.argmax(xi))
+        ends, dofs, n_zero = self._ends(xi)
+        theta = self.w.x.array[dofs]
+        n = plane_complex(force.eval(cells).reshape(-1, 3), self.kin.plane) if force else n_zero
+        (i0, i1), (a, b) = ends, PLANES[self.kin.plane][:2]
         du = chord_increments(theta[:, i0], theta[:, i1], c, h, sign, block, n)
-        a, b, _ = PLANES[self.kin.plane]
-        inc = np.zeros((n_cells, len(xi), 3))
+        inc = np.zeros((len(cells), len(xi), 3))
         inc[:, i1, a], inc[:, i1, b] = du.real, du.imag
         return inc
+
+    def _ends(self, xi):
+        """((ξ = 0 node, ξ = 1 node), the θ dofs per local cell, the section force of a
+        model without forces: zero) for the closed form, found once."""
+        if self._end_data is None:
+            n_cells = self.mesh.mesh.topology.index_map(1).size_local
+            dofs = self.W.dofmap.list.array.reshape(-1, len(xi))[:n_cells]
+            n_zero = plane_complex(np.zeros((n_cells, 3)), self.kin.plane)
+            self._end_data = ((int(np.argmin(xi)), int(np.argmax(xi))), dofs, n_zero)
+        return self._end_data
 
 
 __all__ = [

@@ -7,9 +7,17 @@ from typing import Any
 
 import numpy as np
 
+#: the types :func:`plain` returns as they are (checked first: a run's path holds thousands)
+_SCALARS = frozenset((float, int, str, bool, type(None)))
+
 
 def plain(obj: object) -> object:
     """``obj`` as JSON-ready lists, dicts and numbers (NumPy, NamedTuples, dataclasses)."""
+    kind = type(obj)
+    if kind in _SCALARS:
+        return obj
+    if kind is list and all(type(v) is float for v in obj):  # a vector: copied as it is
+        return list(obj)
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, np.generic):

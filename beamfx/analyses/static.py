@@ -41,19 +41,21 @@ class _State(SavedState):
         self.w.x.scatter_forward()
 
 
-def load_scale(model, F):
+def load_scale(model, F, vector=None):
     """Norm of the load vector at the undeformed state (compiled residual ``F``), to set an
-    absolute residual tolerance in the problem's units."""
+    absolute residual tolerance in the problem's units. ``vector``: a vector of ``F``'s space
+    to assemble into (e.g. the solver's residual vector before its solve), else a new one."""
     import dolfinx.fem.petsc as fp
 
     from ..solvers.assembly import assemble_load
 
     w0 = model.w.x.array.copy()
     model.reset()
-    f = fp.create_vector(F)
+    f = fp.create_vector(F) if vector is None else vector
     assemble_load(f, F, model.load_factor, model.bcs)
     norm = f.norm()
-    f.destroy()
+    if vector is None:
+        f.destroy()
     model.w.x.array[:] = w0
     return norm
 
@@ -106,7 +108,7 @@ def solve_static(
     solver = solver or NewtonSolver(
         model.F, model.J, model.w, model.bcs, prefix, options, coupling=model.coupling
     )
-    full_load = load_scale(model, solver.F)
+    full_load = load_scale(model, solver.F, solver.b)  # b: overwritten by every residual
     solver.set_sizes(state_sizes(model))
     compile_time = compile_seconds[0] - c0
 
@@ -151,25 +153,19 @@ def solve_static(
 
 def tangent_condition(solver, saddle=False):
     """The condition estimate (:mod:`~beamfx.solvers.conditioning`) of the tangent at the
-    solver's current state (assembled once more), or None for a large model; ``saddle``: the
-    mixed formulation's saddle-point tangent. Collective."""
-    import dolfinx.fem.petsc as fp
-
+    solver's current state (assembled once more, into the solver's own matrix: Newton
+    assembles it again before any use), or None for a large model; ``saddle``: the mixed
+    formulation's saddle-point tangent. Collective."""
     from ..solvers.assembly import assemble_tangent
     from ..solvers.conditioning import LIMIT, condition_estimate
-    from ..solvers.snes import constrained_rows
 
-    A = fp.create_matrix(solver.J)
-    try:
-        if A.getSize()[0] > LIMIT:
-            return None
-        assemble_tangent(A, solver.J, solver.bcs)
-        if solver.coupling:
-            solver.coupling.add_to_tangent(A)
-        fixed = constrained_rows(solver.bcs, A.getLocalSize()[0])
-        return condition_estimate(A, fixed, saddle=saddle)
-    finally:
-        A.destroy()
+    A = solver.A
+    if A.getSize()[0] > LIMIT:
+        return None
+    assemble_tangent(A, solver.J, solver.bcs)
+    if solver.coupling:
+        solver.coupling.add_to_tangent(A)
+    return condition_estimate(A, solver.constrained_rows(), saddle=saddle)
 
 
 def _saddle(model):

@@ -136,12 +136,15 @@ def export(out_dir):
     return data
 
 
-def run_beamfx(out_dir, log=print):
-    """Run beamfx on every problem through :func:`.run.run_case`; write ``beamfx.json``."""
+def run_beamfx(out_dir, log=print, problems=None):
+    """Run beamfx on every problem (or those named in ``problems``) through
+    :func:`.run.run_case`; write ``beamfx.json``."""
     from .run import run_case
 
     records, refs = [], {}
     for pid, case in _cases().items():
+        if problems and pid not in problems:
+            continue
         if log:
             log(f"beamfx {pid}: {case.id}")
         result = run_case(case, log)
@@ -168,6 +171,8 @@ def run_beamfx(out_dir, log=print):
                     "first_s": row["wall_s_cold"],
                     "wall_s": row["wall_s_warm"],
                     "process_s": row.get("wall_s_process"),
+                    "whole_split": row.get("whole_split"),  # the warm run's own split
+                    "load_steps": row.get("load_steps"),
                     "error": row["error"],
                     "values": row["values"],
                     "is_reference": finest and i == len(result["rows"]) - 1,
@@ -234,6 +239,30 @@ def measure_processes(records, problems, log=print):
     return measured
 
 
+def measure_stack(records, problems, log=print):
+    """The stack's fixed costs (:func:`.peers_stack.stack_costs`) of the beamfx setting that
+    reaches the target where beamfx is not ahead on whole runs (a P1 setting), where not yet
+    measured: the why-line's floor; returns how many were measured."""
+    from . import all_cases
+    from .peers_stack import stack_costs
+
+    measured = 0
+    for pid, meta in problems.items():
+        s = summary(records, pid)
+        fx = s["beamfx_at_target"]
+        if s["beamfx_ahead"] or fx is None or fx.get("stack_s") is not None:
+            continue
+        setting = fx.get("case_setting") or []
+        if len(setting) != 2 or setting[1] != 1:
+            continue
+        fx["stack_s"] = stack_costs(all_cases()[meta["beamfx_case"]], setting)
+        measured += 1
+        if log:
+            parts = ", ".join(f"{k} {v:.2e}" for k, v in fx["stack_s"].items())
+            log(f"beamfx {pid} {fx['setting']}: stack costs (s) {parts}")
+    return measured
+
+
 def merge(peer_dir, report_dir, run=True, log=print):
     """Write the peer report: beamfx records (run now, or read from ``peer_dir/beamfx.json``)
     + peer records -> ``report_dir/peers.md``, ``peers.json`` and one ``peers_<problem>.png``
@@ -251,7 +280,8 @@ def merge(peer_dir, report_dir, run=True, log=print):
     notes = NOTES | (json.loads(notes_file.read_text()) if notes_file.exists() else {})
     for pid, text in load_peer_notes(peer_dir).items():
         notes[pid] = f"{notes[pid]} {text}" if pid in notes else text
-    if measure_processes(records, problems, log):  # kept for a later --no-run merge
+    measured = measure_processes(records, problems, log) + measure_stack(records, problems, log)
+    if measured:  # kept for a later --no-run merge
         (peer_dir / "beamfx.json").write_text(json.dumps({"references": refs, "records": fx}))
     report.mkdir(parents=True, exist_ok=True)
     for pid, meta in problems.items():
@@ -268,16 +298,25 @@ def merge(peer_dir, report_dir, run=True, log=print):
 
 
 def main(argv=None):
-    """Command line: ``export DIR``, ``beamfx DIR`` or ``DIR REPORT_DIR [--no-run]``."""
+    """Command line: ``export DIR``, ``beamfx DIR [PROBLEM ...]`` (beamfx's side alone, of
+    the problems named) or ``DIR REPORT_DIR [--no-run]``."""
     argv = list(sys.argv[1:] if argv is None else argv)
     usage = (
-        "usage: python -m beamfx.bench.peers export DIR | beamfx DIR | DIR REPORT_DIR [--no-run]"
+        "usage: python -m beamfx.bench.peers export DIR | beamfx DIR [PROBLEM ...] | "
+        "DIR REPORT_DIR [--no-run]"
     )
     if len(argv) == 2 and argv[0] == "export":
         export(argv[1])
-    elif len(argv) == 2 and argv[0] == "beamfx":
+    elif len(argv) >= 2 and argv[0] == "beamfx":
+        unknown = set(argv[2:]) - set(PROBLEMS)
+        if unknown:
+            raise SystemExit(f"unknown problems {sorted(unknown)}; known: {list(PROBLEMS)}")
         t0 = time.perf_counter()
-        run_beamfx(argv[1])
+        records, _ = run_beamfx(argv[1], problems=argv[2:])
+        for r in records:
+            print(
+                f"{r['problem']} {r['setting']}: whole {r['whole_s']:.4f} s, solve {r['wall_s']:.5f} s"
+            )
         print(f"beamfx: {time.perf_counter() - t0:.1f} s")
     elif len(argv) in (2, 3) and argv[0] not in ("export", "beamfx"):
         merge(argv[0], argv[1], run="--no-run" not in argv)

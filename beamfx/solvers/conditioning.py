@@ -26,27 +26,30 @@ SCALING = "symmetric diagonal D K D, D = diag(|K_ii|)^(-1/2) on the free dofs"
 SADDLE_SCALING = "symmetric equilibration D K D (Ruiz, 10 sweeps) on the free dofs"
 
 
-def gather(A, fixed_rows):
+def gather(A, fixed_rows, dense=False):
     """(K, free) on rank 0, (None, None) elsewhere: the PETSc matrix ``A`` as a SciPy CSR
-    matrix and the global indices of its free rows (``fixed_rows``: the owned local indices
-    of the constrained rows on each rank). Collective."""
-    import scipy.sparse as sp
-
+    matrix (a NumPy array if ``dense``: SciPy's construction costs more than a small model's
+    whole estimate) and the global indices of its free rows (``fixed_rows``: the owned local
+    indices of the constrained rows on each rank). Collective."""
     comm = A.getComm().tompi4py()
     n = A.getSize()[0]
     start = A.getOwnershipRange()[0]
     ai, aj, av = A.getValuesCSR()  # owned rows, global columns
-    parts = comm.gather((start, ai, aj, av, np.asarray(fixed_rows, np.int64) + start), root=0)
+    part = (start, ai, aj, av, np.asarray(fixed_rows, np.int64) + start)
+    parts = comm.gather(part, root=0) if comm.size > 1 else [part]
     if comm.rank != 0:
         return None, None
-    rows = [np.repeat(np.arange(len(p[1]) - 1), np.diff(p[1])) + p[0] for p in parts]
-    K = sp.csr_matrix(
-        (
-            np.concatenate([p[3] for p in parts]),
-            (np.concatenate(rows), np.concatenate([p[2] for p in parts])),
-        ),
-        shape=(n, n),
+    rows = np.concatenate(
+        [np.repeat(np.arange(len(p[1]) - 1), np.diff(p[1])) + p[0] for p in parts]
     )
+    cols, values = np.concatenate([p[2] for p in parts]), np.concatenate([p[3] for p in parts])
+    if dense:  # (PETSc's rows hold each column once: the entries are placed, not summed)
+        K = np.zeros((n, n))
+        K[rows, cols] = values
+    else:
+        import scipy.sparse as sp
+
+        K = sp.csr_matrix((values, (rows, cols)), shape=(n, n))
     free = np.setdiff1d(np.arange(n), np.concatenate([p[4] for p in parts]))
     return K, free
 
@@ -107,12 +110,13 @@ def condition_estimate(A, fixed_rows, limit=LIMIT, saddle=False):
     comm = A.getComm().tompi4py()
     if A.getSize()[0] > limit:
         return None
-    K, free = gather(A, fixed_rows)
+    # a matrix of at most DENSE_LIMIT rows dense: SciPy's sparse indexing and products cost
+    # more than the SVD there
+    dense = A.getSize()[0] <= DENSE_LIMIT
+    K, free = gather(A, fixed_rows, dense)
     out = None
     if comm.rank == 0:
-        # a matrix of at most DENSE_LIMIT rows dense: SciPy's sparse indexing and products cost
-        # more than the SVD there
-        K = K.toarray()[np.ix_(free, free)] if K.shape[0] <= DENSE_LIMIT else K[free][:, free]
+        K = K[np.ix_(free, free)] if dense else K[free][:, free]
         value, norm = condition(equilibrated(K) if saddle else scaled(K))
         unscaled, _ = condition(K)
         out = {

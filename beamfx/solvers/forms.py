@@ -46,6 +46,7 @@ def remember_loaded_modules():
         return
     _lazy_parameter_log()
     _expression_signature_once()
+    _lazy_form_constants()
     lookup, loaded = jit.get_cached_module, {}
 
     def get_cached_module(module_name, object_names, cache_dir, timeout):
@@ -134,6 +135,56 @@ def _combined(object_signature, kind, tag):
         tag,
     ]
     return hashlib.sha1(";".join(parts).encode("utf-8")).hexdigest()
+
+
+def _lazy_form_constants():
+    """UFL 2022.2's ``Form.__init__`` lists the form's constants at once, a traversal of every
+    integrand, and every sum, difference, scaling and derivative of forms makes a new Form:
+    eleven traversals of the energy while the condensed roll-up builds its residual and
+    tangent (about a millisecond, a tenth of the model's build), of which only the two
+    compiled forms read theirs. Form is given an ``__init__`` that leaves the list to its
+    first read (``constants``, ``constant_numbering`` and the signature's renumbering): the
+    same list, the same signatures. Idempotent."""
+    import ufl.form as uf
+    from ufl.algorithms.analysis import extract_constants
+    from ufl.log import error
+
+    Form = uf.Form
+    if getattr(Form.constants, "beamfx_lazy", False):
+        return
+    renumbering, original = Form._compute_renumbering, Form.__init__
+
+    def __init__(self, integrals):  # UFL's, but for the constants
+        if not all(isinstance(itg, uf.Integral) for itg in integrals):
+            error("Expecting list of integrals.")
+        self._integrals = uf._sorted_integrals(integrals)
+        self._integration_domains = self._domain_numbering = self._subdomain_data = None
+        self._arguments = self._coefficients = self._coefficient_numbering = None
+        self._constants = self._constant_numbering = None  # at first read
+        self._hash = self._signature = None
+        self._cache = {}
+
+    def _listed(self):
+        if self._constants is None:
+            self._constants = extract_constants(self)
+            self._constant_numbering = {c: i for i, c in enumerate(self._constants)}
+
+    def constants(self):
+        _listed(self)
+        return self._constants
+
+    def constant_numbering(self):
+        """Return a contiguous numbering of constants in a mapping ``{constant:number}``."""
+        _listed(self)
+        return self._constant_numbering
+
+    def _compute_renumbering(self):
+        _listed(self)
+        return renumbering(self)
+
+    constants.beamfx_lazy, __init__.original = True, original
+    Form.__init__, Form.constants, Form.constant_numbering = __init__, constants, constant_numbering
+    Form._compute_renumbering = _compute_renumbering
 
 
 class _Formatted:

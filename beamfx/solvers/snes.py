@@ -162,6 +162,10 @@ class NewtonSolver:
         self.seconds["test"] += time.perf_counter() - t
         return reason
 
+    def constrained_rows(self):
+        """Owned local rows of the constrained dofs (:func:`constrained_rows` of its bcs)."""
+        return self._rows
+
     def set_atol(self, atol):
         """Absolute residual tolerance, in the units of the residual (force, moment)."""
         self.atol = float(atol)

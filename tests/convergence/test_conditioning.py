@@ -191,6 +191,23 @@ def test_a_small_tangent_gives_the_same_numbers_dense_and_sparse():
         assert condition(M) == condition(sp.csr_matrix(M))
 
 
+def test_the_dense_gather_holds_the_sparse_one():
+    """A small tangent gathered dense (no SciPy CSR) holds the entries of the sparse gather,
+    and the same free rows."""
+    from petsc4py import PETSc
+
+    A = PETSc.Mat().createAIJ((4, 4), comm=PETSc.COMM_SELF)
+    A.setUp()
+    for i, j, v in ((0, 0, 4.0), (0, 1, -1.5), (1, 0, -1.5), (1, 1, 3.0), (2, 2, 1.0), (3, 3, 2e6)):
+        A.setValue(i, j, v)
+    A.assemble()
+    K, free = conditioning.gather(A, [2], dense=True)
+    S, free_s = conditioning.gather(A, [2])
+    assert isinstance(K, np.ndarray) and np.array_equal(K, S.toarray())
+    assert free.tolist() == free_s.tolist() == [0, 1, 3]
+    A.destroy()
+
+
 def test_the_mixed_form_solves_it_exactly(tmp_path):
     """The same cantilever with "auto": the mixed form (shear-rigid: an exact constraint, no
     penalty) at EA, GA ×1e8 converges by the residual test, the tip deflection is

@@ -168,6 +168,30 @@ def test_the_scene_builder_picks_the_planar_condensed_model(tmp_path, load, plan
     assert any(("planar statically condensed" in x) == planar for x in lines if "condensed" in x)
 
 
+def test_a_static_run_builds_no_inertia_and_splits_its_time(tmp_path):
+    """The inertia field of a static model is made at first read only (a static run reads
+    none), then with the section's values; results.json's wall_time_s has the model build and
+    the per-step output (probes, reactions, frames), which fit in the whole run."""
+    from beamfx.analyses.discretisation import Deferred
+    from beamfx.runner import run_scene
+    from beamfx.scene import load_scene
+
+    path = tmp_path / "s.toml"
+    path.write_text(_scene("force = [0, 0, 0.1]"))
+    scene = load_scene(path)
+    model = build_model(scene.model, MPI.COMM_WORLD, (), True)
+    solve_static(model, steps=2)
+    d = model.discretisation
+    assert isinstance(d.mass, Deferred)
+    rho_A = d.inertia.x.array.reshape(-1, 4)[:, 0]
+    assert d.inertia is d.inertia and not isinstance(d.mass, Deferred)
+    assert np.allclose(rho_A, 1.0 * 0.1 * 0.1, rtol=1e-14)
+    seconds = run_scene(path, tmp_path / "out", log=lambda *a: None)["wall_time_s"]
+    parts = ("model", "output_probes", "output_reactions", "output_frames")
+    assert all(seconds[k] > 0 for k in parts)
+    assert sum(seconds[k] for k in parts) + seconds["compile"] < seconds["run"]
+
+
 def test_a_modal_plane_problem_is_neither_planar_nor_condensed(tmp_path):
     from beamfx.scene import load_scene
 

@@ -70,6 +70,30 @@ def test_verdict_on_whole_runs_with_the_solve_only_verdict_beside_it():
     assert "beamfx 0.5 s (4 x P4) against Exudyn (GE) 0.2 s: 2.5 x the time" in md
 
 
+def test_the_why_line_states_the_measured_split_and_the_stack_floor():
+    """Where beamfx is behind, the bullet names each measured part of its warm run, the rest
+    (whole minus the parts), and the stack's costs measured alone with the floor they make:
+    mesh + 5 spaces + forms + expression + solve + a frame per load step."""
+    split = {"model": 0.004, "compile": 0.002, "condition": 0.0003, "output_probes": 0.003}
+    split |= {"output_reactions": 0.001, "output_frames": 0.004, "total": 0.011, "run": 0.018}
+    stack = {"mesh": 0.0002, "space": 0.0001, "forms": 0.002, "expression": 0.0015}
+    fx = _rec("beamfx", "4 x P1", 0.001, 1e-15, whole_s=0.02, whole_split=split)
+    fx |= {"stack_s": stack | {"frame": 0.0005}, "load_steps": 4}
+    recs = [fx, _rec("Exudyn", "2", 0.004, 1e-12, element="GE", whole_s=0.005)]
+    md = peers.markdown(recs, {"p": {"title": "fake", "beamfx_case": "c"}})
+    line = next(x for x in md.splitlines() if x.startswith("- **p**"))
+    assert "model build (mesh, function spaces, UFL forms, frame writers) 0.004" in line
+    assert "solve 0.001, condition estimate 0.0003" in line
+    assert "frames (VTK files) 0.004, the rest (load stepping, folder, log, results.json) " in line
+    rest = 0.02 - (0.004 + 0.002 + 0.001 + 0.0003 + 0.003 + 0.001 + 0.004)
+    assert f"results.json) {rest:.3g}." in line
+    floor = 0.0002 + 5 * 0.0001 + 0.002 + 0.0015 + 0.001 + 4 * 0.0005
+    assert "one frame 0.0005 (x 4 load steps)" in line and f"floor of {floor:.3g} s" in line
+    fx.pop("whole_split"), fx.pop("stack_s")  # an older record: solve and rest only
+    md = peers.markdown(recs, {"p": {"title": "fake", "beamfx_case": "c"}})
+    assert "0.001 s is the solve and 0.019 s the rest" in md
+
+
 def test_peer_files_give_whole_and_process_times(tmp_path):
     """A peer file's import time + a record's first run = its process time; an older file's
     whole run is its model build + warm solve."""
@@ -120,3 +144,14 @@ def test_every_bench_formulation_has_an_element_name():
         assert element_name(kind) == ELEMENTS[kind]
     assert element_name("full mixed").endswith("mixed (section force unknowns)")
     assert element_name("planar mixed").startswith(ELEMENTS["planar"])
+
+
+def test_stack_costs_of_a_rollup_setting():
+    """The stack's parts of a P1 roll-up, each timed alone: all measured, each below the
+    whole run it is part of (a generous bound: seconds on a loaded machine)."""
+    from beamfx.bench import all_cases
+    from beamfx.bench.peers_stack import stack_costs
+
+    costs = stack_costs(all_cases()["rollup_0.5"], (1, 1), repeats=1)
+    assert set(costs) == {"mesh", "space", "forms", "expression", "frame"}
+    assert all(0 < v < 5.0 for v in costs.values())

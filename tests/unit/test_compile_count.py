@@ -223,6 +223,31 @@ def test_an_expression_signature_is_ffcx_own_and_computed_once(monkeypatch):
     assert len(calls) == 1
 
 
+def test_forms_list_their_constants_when_read_as_ufl_does():
+    """A form made by sums, scalings and derivatives (each a new Form) lists its constants
+    at the first read (forms.remember_loaded_modules): the same constants, numbering and
+    signature as UFL's own Form.__init__, which lists them at once."""
+    import dolfinx
+    import ufl
+    from mpi4py import MPI
+
+    from beamfx.solvers.forms import remember_loaded_modules
+
+    remember_loaded_modules()
+    mesh = dolfinx.mesh.create_unit_interval(MPI.COMM_WORLD, 2)
+    V = dolfinx.fem.FunctionSpace(mesh, ufl.FiniteElement("Lagrange", mesh.ufl_cell(), 1))
+    u, v = dolfinx.fem.Function(V), ufl.TestFunction(V)
+    a, b = dolfinx.fem.Constant(mesh, 2.0), dolfinx.fem.Constant(mesh, 3.0)
+    Pi = a * u**2 * ufl.dx - b * u * ufl.ds
+    F = ufl.derivative(Pi, u, v) - 0.5 * (b * v * ufl.dx)
+    assert F._constants is None  # nothing listed yet
+    eager = ufl.Form.__new__(ufl.Form)
+    ufl.Form.__init__.original(eager, F.integrals())
+    assert F.constants() == eager.constants() == [a, b]
+    assert F.constant_numbering() == eager.constant_numbering()
+    assert F.signature() == eager.signature()
+
+
 def test_compile_flags_get_a_cache_of_their_own():
     """BEAMFX_JIT_CFLAGS (the test suite's "-O0 -g0") sets the C flags and a cache folder
     beside the default one, so kernels built with other flags never serve a user's run."""

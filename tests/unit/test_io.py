@@ -363,6 +363,30 @@ def test_json_atomic_and_writable(tmp_path):
         check_writable(bad)
 
 
+def test_json_levels_one_item_a_line_with_the_values_of_json():
+    """results.json's layout: the first two levels one item a line (indented as indent=1),
+    deeper values on their item's line; the same values as json.dumps, NumPy included."""
+    from beamfx.io.results import dumps
+
+    obj = {"a": [1.5, {"b": [2, 3]}], "c": {"d": np.arange(2)}, "e": [], "f": {}, "g": {1: 2}}
+    text = dumps(obj)
+    assert json.loads(text) == {**obj, "c": {"d": [0, 1]}, "g": {"1": 2}}
+    assert text.splitlines() == [
+        "{",
+        ' "a": [',
+        "  1.5,",
+        '  {"b": [2, 3]}',
+        " ],",
+        ' "c": {',
+        '  "d": [0, 1]',
+        " },",
+        ' "e": [],',
+        ' "f": {},',
+        ' "g": {"1": 2}',
+        "}",
+    ]
+
+
 class _Tty(io.StringIO):
     def isatty(self):
         return True
