@@ -109,19 +109,31 @@ def owned_force_dofs(model):
     return dofs[dofs < owned_size(model.W)]
 
 
+#: c in the mixed form's quaternion penalty k_p = c·max(EI, GJ)/h_min² (:func:`quaternion_penalty`)
+PENALTY_FACTOR = 1e7
+
+
 def quaternion_penalty(d):
     """The mixed form's quaternion penalty k_p on the discretisation ``d``: its tangent holds
-    no EA or GA, and k_p must not either (the displacement form's is 10·max(EA, GA)). 10 times
-    the largest bending or torsion stiffness over the shortest element squared, the size of
-    the bending terms on the rotation unknowns. With the penalty at the nodes of q (the
-    model's default ``penalty_rule``) the answer does not depend on k_p beyond the nodal norm
-    drift O(1/k_p). With ``penalty_rule="quadrature"`` it holds |q| = 1 at the Gauss points,
-    between the nodes, and moves the answer at the discretisation error: there the smaller
-    k_p is the more accurate (45° bend, 8 × P2 tip error 1.3e-5 with it, 1.1e-3 with 10 EA,
-    from a 32 × P4 reference). The two forms agree to round-off with the same k_p (the
-    model's ``k_penalty`` is a Constant). Collective."""
+    no EA or GA, and k_p must not either (the displacement form's is 10·max(EA, GA)).
+    :data:`PENALTY_FACTOR` times the largest bending or torsion stiffness over the shortest
+    element squared, the size of the bending terms on the rotation unknowns.
+
+    With the penalty at the nodes of q (the model's default ``penalty_rule``) the answer moves
+    only by the nodal norm drift: R(q) is scale-free pointwise, but the interpolant of
+    quaternions whose nodal norms differ turns between the nodes, so the strain energy has a
+    gradient in the nodal norms that the penalty balances by a drift ∝ 1/k_p (issue 16: the
+    star dome, 1 × P2, static at 60 kN, moves 9.4e-4/c relative, exactly ∝ 1/c from c = 10
+    to 1e10). c = 1e7 keeps it near 1e-10 there; the scaled condition estimate of the tangent
+    grows ∝ c (626 at c = 10, 3.8e5 at 1e7; the displacement form's 1.4e9) and does not
+    depend on EA, GA; Newton takes about twice the iterations of c = 10. With
+    ``penalty_rule="quadrature"`` it holds |q| = 1 at the Gauss points, between the nodes,
+    and moves the answer at the discretisation error: there a small k_p is the more accurate
+    (45° bend, 8 × P2 tip error 1.3e-5 with 10·EI/h², 1.1e-3 with 10 EA, from a 32 × P4
+    reference). The two forms agree to round-off with the same k_p (the model's
+    ``k_penalty`` is a Constant). Collective."""
     from mpi4py import MPI
 
     bend = d.stiffness.x.array.reshape(-1, 6)[:, 3:]  # diagonals, matrix sections too
     top = d.comm.allreduce(float(bend.max()) if len(bend) else 0.0, op=MPI.MAX)
-    return 10 * top / d.min_cell_length() ** 2
+    return PENALTY_FACTOR * top / d.min_cell_length() ** 2
