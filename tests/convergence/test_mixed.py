@@ -73,7 +73,7 @@ def test_own_penalty_is_within_the_discretisation_error():
     the displacement model's: both within 1e-4 of a 16 × P4 reference at 4 × P3 (observed
     2.3e-7), and within 1e-10 of each other. What parts them is the nodal norm drift of each
     penalty, ∝ 1/k_p: the former mixed c = 10 moved the tip 1.4e-9; the displacement form's
-    10 EA is c = 10 EA h²/max(EI) ≈ 3e3 here, so ≈ 5e-12 (observed 4.6e-12 with c = 1e7)."""
+    10 EA is c = 10 EA h²/max(EI) ≈ 3e3 here, so ≈ 5e-12 (observed 4.5e-12 with c = 1e6)."""
     spec = cantilever(straight(1.0), SECTION, 4, 3, force=(0.0, 1.0, 2.0), moment=(0.5, 0, 0))
     fine = replace(spec, beams=tuple(replace(b, elements=16, degree=4) for b in spec.beams))
     ref = np.asarray(_static(fine, "displacement")[2]["b:end"]["position"])
@@ -127,7 +127,7 @@ def test_penalty_model_converges(factor):
     (the penalty form's tangent is singular there), the answer is the ×1 one to round-off and
     the scaled condition number does not grow with the factor: it is set by the quaternion
     penalty c·max(EI, GJ)/h² against the bending terms EI/h², so below 10·c at both factors
-    (observed 6.8e7 with c = 1e7; below 1e6 with the former c = 10)."""
+    (observed 6.8e6 at both with c = 1e6; below 1e6 with the former c = 10)."""
     kin = Kinematics(shear=False, stretch=False)
     spec = cantilever(
         straight(1.0), SECTION, 4, 3, force=(0.0, 1.0, 2.0), moment=(0.5, 0, 0), kinematics=kin
