@@ -110,7 +110,7 @@ def owned_force_dofs(model):
 
 
 #: c in the mixed form's quaternion penalty k_p = c·max(EI, GJ)/h_min² (:func:`quaternion_penalty`)
-PENALTY_FACTOR = 1e6
+PENALTY_FACTOR = 1e3
 
 
 def quaternion_penalty(d):
@@ -124,13 +124,15 @@ def quaternion_penalty(d):
     quaternions whose nodal norms differ turns between the nodes, so the strain energy has a
     gradient in the nodal norms that the penalty balances by a drift ∝ 1/k_p (issue 16: the
     star dome, 1 × P2, static at 60 kN, moves 9.4e-4/c relative, exactly ∝ 1/c from c = 10
-    to 1e10; 2 × P2: 1.4e-5/c; a 3D roll-up past 2π, 8 × P3: 2e-9/c). c = 1e6 holds it
-    to 9.4e-10 on that coarsest dome and below 1e-11 on finer meshes. The price grows ∝ c:
-    the scaled condition estimate of the tangent (dome 1 × P2: 626 at c = 10, 3.8e4 at 1e6,
-    the displacement form's 1.4e9; it does not depend on EA, GA), Newton's round-off floor
-    k_p·ε on the quaternion rows (at c ≥ 1e5 the steps end by the floor criterion: static
-    dome 31 → 59 iterations, arc-length dome 33 → 170), hence arc-length steps: at c = 1e7
-    the star dome 4 × P2 with EA, GA ×1e8 ran out of its 300 steps, at 1e6 it passes. With
+    to 1e10; 2 × P2: 1.4e-5/c; a 3D roll-up past 2π, 8 × P3: 2e-9/c). c = 1e3 holds it
+    to 9.4e-7 on that coarsest dome (whose discretisation error is 6e-2), 1.4e-8 at 2 × P2,
+    far below the discretisation error at every mesh. A larger c costs ∝ c: the scaled
+    condition estimate of the tangent (dome 1 × P2: 626 at c = 10, 596 at 1e3, 3.8e4 at
+    1e6, the displacement form's 1.4e9; it does not depend on EA, GA) and Newton's round-off
+    floor k_p·ε on the quaternion rows: from c = 1e5 the steps end by the floor criterion
+    (static dome 31 iterations at c = 10, 33 at 1e3, 59 at 1e6; arc-length dome 33 → 170 at
+    1e6), and at c = 1e7 the star dome 4 × P2 with EA, GA ×1e8 ran out of its 300 arc-length
+    steps. c = 1e3 is the largest c that costs no iterations. With
     ``penalty_rule="quadrature"`` it holds |q| = 1 at the Gauss points, between the nodes,
     and moves the answer at the discretisation error: there a small k_p is the more accurate
     (45° bend, 8 × P2 tip error 1.3e-5 with 10·EI/h², 1.1e-3 with 10 EA, from a 32 × P4
