@@ -225,13 +225,19 @@ def located_limits(result, limits):
     an extremum without a limit point in its steps is left out: the load factor of a smooth
     path has an extremum only where the tangent is singular (K w' = λ' f = 0), so that one
     is a zigzag of the steps (a path so steep in the measured displacements, EA × 1e8, that
-    round-off moves λ by more than the step does)."""
+    round-off moves λ by more than the step does). A located limit point without an
+    extremum in its steps (the path ends within a step past it) is placed in its step
+    (:func:`~beamfx.analyses.continuation.limit_in_step`)."""
+    from .continuation import limit_in_step
+
     counted = any(p.negative_eigenvalues is not None for p in result.path[1:])
-    found = {}
+    found, alone = {}, []
     for c in result.critical_points:
         i = _near(result, limits, c) if c.kind == "limit" else None
         if i is not None:
             found.setdefault(i, c.load_factor)
+        elif c.kind == "limit" and c.load_factor is not None:  # e.g. the path ends past it
+            alone.append(limit_in_step(result.path, c.step, c.load_factor))
     out = []
     for i, p in enumerate(limits):
         if i not in found:
@@ -239,7 +245,7 @@ def located_limits(result, limits):
                 out.append(p)
             continue
         out.append(p if found[i] is None else p._replace(load_factor=found[i]))
-    return out
+    return sorted(out + alone, key=lambda p: p.arc_length)
 
 
 def critical_points(result, limits):

@@ -240,6 +240,24 @@ def model_size(model):
     return model.comm.allreduce(local, op=MPI.MAX)
 
 
+def limit_in_step(path, step, load_factor):
+    """The :class:`LimitPoint` of a limit point located (by the inertia) at ``load_factor``
+    inside ``step`` (between path points ``step`` − 1 and ``step``) where the path has no
+    discrete extremum there, e.g. when the path ends within a step of the limit: its place
+    s and displacement from the parabola λ(s) through the step's points and the one before,
+    its vertex kept within the step."""
+    i = min(max(step, 2), len(path) - 1)
+    lam = np.array([p.load_factor for p in path[i - 2 : i + 1]])
+    s = np.array([p.arc_length for p in path[i - 2 : i + 1]])
+    u = np.array([p.displacement for p in path[i - 2 : i + 1]]).reshape(-1, 3)
+    c = np.polyfit(s - s[1], lam, 2)
+    ds = -c[1] / (2 * c[0]) if c[0] != 0 else s[2] - s[1]
+    ds = float(np.clip(ds, 0.0, s[2] - s[1]))
+    du = [np.polyval(np.polyfit(s - s[1], u[:, k], 2), ds) for k in range(3)]
+    kind = "maximum" if load_factor >= max(lam[1], lam[2]) else "minimum"
+    return LimitPoint(kind, float(load_factor), np.array(du), float(s[1] + ds))
+
+
 def limit_points(path):
     """Local extrema of the load factor along a path, located by a parabola in s.
 
