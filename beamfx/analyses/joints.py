@@ -33,11 +33,10 @@ def _cell_at(m, vertex, original):
     return c, int(np.flatnonzero(m.topology.connectivity(1, 0).links(c) == vertex)[0])
 
 
-def joint_density(disc, at):
-    """The values of ψ of the module doc at the DG_p nodes of each local cell, (n_cells,
-    p + 1), for the named point ``at`` of the
-    :class:`~beamfx.analyses.discretisation.Discretisation` ``disc``: nonzero on one element
-    next to the point (the one first in input order, so every rank picks the same).
+def joint_cells(disc, at):
+    """The nonzero rows of :func:`joint_density`: (local cell, ψ at its DG_p nodes) for each
+    local vertex of the named point ``at`` (O(1) in the mesh size, so that many joint loads
+    can share one field).
 
     Raises:
         ValueError: if that element is curved or its nodes are not evenly spaced.
@@ -45,10 +44,9 @@ def joint_density(disc, at):
     m, p = disc.mesh.mesh, disc.degree
     m.topology.create_connectivity(0, 1)
     m.topology.create_connectivity(1, 0)
-    n_cells = m.topology.index_map(1).size_local + m.topology.index_map(1).num_ghosts
     original = np.asarray(m.topology.original_cell_index)
     xi = np.r_[0.0, 1.0, np.arange(1, p) / p]  # basix order of the DG and geometry nodes
-    values = np.zeros((n_cells, len(xi)))
+    rows = []
     for v in disc.mesh.point_tags.find(disc.mesh.points[at][0]):
         c, end = _cell_at(m, int(v), original)
         x = m.geometry.x[m.geometry.dofmap.links(c)]
@@ -59,8 +57,25 @@ def joint_density(disc, at):
                 f"{at!r}: a point load where more than two elements meet needs a straight "
                 "element with evenly spaced nodes next to it"
             )
-        values[c] = kernel(xi, end, p) / h
+        rows.append((c, kernel(xi, end, p) / h))
+    return rows
+
+
+def joint_density(disc, at):
+    """The values of ψ of the module doc at the DG_p nodes of each local cell, (n_cells,
+    p + 1), for the named point ``at`` of the
+    :class:`~beamfx.analyses.discretisation.Discretisation` ``disc``: nonzero on one element
+    next to the point (the one first in input order, so every rank picks the same).
+
+    Raises:
+        ValueError: if that element is curved or its nodes are not evenly spaced.
+    """
+    m = disc.mesh.mesh
+    n_cells = m.topology.index_map(1).size_local + m.topology.index_map(1).num_ghosts
+    values = np.zeros((n_cells, disc.degree + 1))
+    for c, row in joint_cells(disc, at):
+        values[c] = row
     return values
 
 
-__all__ = ["joint_density", "kernel"]
+__all__ = ["joint_cells", "joint_density", "kernel"]

@@ -141,9 +141,16 @@ class BeamModel(Discretised):
             return energy.load_work(kin, rot, v_u, v_rot, force, moment, load.kind, load.arm)
 
         work = 0
+        joints = {}  # dead loads at joints of > 2 elements, by history and axes: one field each
         for ld in spec.point_loads:  # constant on a cell: dead forces, moments if θ is linear
             exact = ld.kind == "dead" and not (kin.finite and not kin.plane and any(ld.moment))
+            if exact and d.elements_at(ld.at) > 2:
+                axes = getattr(ld, "axes", "global")
+                joints.setdefault((id(ld.history), axes), (ld.history, axes, []))[2].append(ld)
+                continue
             work += self._time_factor(ld.history) * d.at_point(ld.at, work_of(ld), exact)
+        for history, axes, loads in joints.values():
+            work += self._time_factor(history) * self._joint_work(loads, axes, v_u, v_rot)
         names = [b.name for b in spec.beams]
         for dl in spec.distributed_loads:
             if dl.beam is None:
@@ -166,6 +173,20 @@ class BeamModel(Discretised):
             self.work = work
             self.F -= self.load_factor * work
         self.J = ufl.derivative(self.F, self.w, ufl.TrialFunction(self.W))
+
+    def _joint_work(self, loads, axes, v_u, v_rot):
+        """Virtual work (a form) of dead point ``loads`` at joints where more than two elements
+        meet, all components in ``axes``: one density field for the forces and one for the
+        moments (:meth:`~beamfx.analyses.discretisation.Discretisation.joint_load_density`),
+        the work of each load being linear in its force and moment."""
+        d, kin = self.discretisation, self.kin
+        fields = []
+        for part in ("force", "moment"):
+            pairs = [(ld.at, getattr(ld, part)) for ld in loads if any(getattr(ld, part))]
+            f = d.joint_load_density(pairs) if pairs else ufl.as_vector([0.0, 0.0, 0.0])
+            fields.append(d.Lam0 * f if axes == "section" and pairs else f)
+        rot = ufl.split(self.w)[1]
+        return energy.load_work(kin, rot, v_u, v_rot, fields[0], fields[1], "dead") * d.dx
 
     def _penalty_scale(self):
         """The quaternion penalty k_p: 10 times the largest EA or GA (before the section

@@ -301,7 +301,7 @@ Outside the Newton iterations: building the model and writing one ParaView frame
 its own piece, nothing gathered), in the last columns. The frame is written after the
 solver's matrix, node-ordered copy and hierarchy are freed and the heap C's allocator keeps
 after a free is returned to the system (as at the end of a run), so the whole case's peak is
-the larger of the solve's and the model's plus the frame's; the 2³–10³ rows, measured
+the larger of the solve's and the model's plus the frame's; the 2³ and 5³ rows, measured
 before that change, wrote the frame on top of the solver.
 
 Before the node blocks (CG + smoothed-aggregation GAMG on the unknowns one by one, the
@@ -328,12 +328,44 @@ model take 33 s (linear) and 43 s (finite) of wall-clock time in the rows below 
 before, at the load of the first 10⁶ run; 56 CPU s under the profiler), and the model holds
 1.8 GB (these rows ran before the element breaks were computed once, 15 % of the build at
 14³). What is left is linear in the members but Python per member: the mesh's vertex list
-and overlap check, the joint search, the 529 point loads of the top face (each adds a term
-and a DG weight field over the whole mesh to the residual: a joint of more than two elements
-takes a dead load exactly on one element; a form of n such terms costs O(n²) to add up in
-UFL and O(n × cells) to assemble: at 10³ cells (linear kinematics) the 121 load terms are
-0.048 of the 0.053 CPU s of one residual; one field for all loads of a history would make it
-O(cells), a change of the shared model code left for later).
+and overlap check, the joint search.
+
+**The two growths of the cost per unknown** (the 2³–22³ rows: CPU per unknown and Newton
+iteration of the iterative rows 2.1× (linear) and 1.7× (finite) from 10⁴ to 10⁶ unknowns).
+(1) The point loads: a dead load at a joint of more than two elements is taken exactly on
+one element next to it, with a DG weight field over the whole mesh (`beamfx/analyses/joints.py`);
+each of the 121 (10³ cells), 225 (14³) and 529 (22³) top-face loads added its own field and
+term, so every residual assembly packed and integrated O(loads × cells) coefficients. Now the
+dead joint loads of one history and axes share one force and one moment density field
+(`Discretisation.joint_load_density`, `Model._joint_work`): the same work, to round-off (the
+load vector of the 5³ lattice differs in 12 of 13,167 entries, by at most 2.2e-16 of 1 N, the
+reassociation of ψ·F; the solution moves by 2e-13, CG's answer to an ulp at rtol 1e-12; the
+star dome's limit loads are bit-identical). (2) The phase "other" (the solve's time outside
+the PETSc events): it held a third residual assembly (the load scale of Newton's test, with
+the same load terms), the condition estimate's `create_matrix` (a sparsity pattern as costly
+as an assembly, built before the size check that then skips the estimate above 2,000
+unknowns) and the node spacing of the round-off floor by `np.maximum.at` (unbuffered, slow in
+NumPy 1.24). Now the spacing is assigned in sorted order, and the estimate goes into the
+solver's own matrix after the size check (a change made on main at the same time; the
+"after" rows measured the size check alone, which skips the same work). Measured in one
+process each, back to back, old code then new (1 rank, linear, iterative; CPU s; load
+average 5–6 on 2 cores):
+
+| cells (unknowns) | residual assembly | load scale | condition | node spacing | other, wall s/it | build model | solve CPU |
+|---|---|---|---|---|---|---|---|
+| 10³ (83,766) before | 0.052 | 0.109 | 0.040 | 0.0165 | 0.93 | 2.33 | 2.24 |
+| 10³ after | 0.0050 | 0.0107 | 0.00005 | 0.0069 | 0.064 | 2.03 | 1.81 |
+| 14³ (225,126) before | 0.275 | 0.535 | 0.110 | 0.049 | 1.87 | 6.24 | 7.54 |
+| 14³ after | 0.0150 | 0.0327 | 0.00009 | 0.027 | 0.19 | 5.66 | 5.67 |
+
+The residual assembly per unknown is now flat (60 and 66 ns at 10³ and 14³, against 620 and
+1,220 ns before); the 22³ rows below were measured before these changes and still hold both
+growths. Finite kinematics at 10³ (97,727 unknowns, 3 Newton iterations): residual 0.054 →
+0.0085, load scale 0.105 → 0.017, condition 0.050 → 0.00005 CPU s; what is left of its
+"other" (0.15 s per iteration) is mostly the round-off floor of Newton's test, once per solve
+(`AbsoluteTangent.floor`: |K| copied from the tangent's CSR and multiplied, 0.42 s), linear
+in the entries. The 10³ rows below were re-measured with these changes; the 2³, 5³ and 22³
+rows were not.
 
 **The frame's memory.** The swept surface of the ParaView frame has 160 points per element
 (32 around the circle at 5 stations) with their u, N and M: writing it took 1.6 GB at 14³
@@ -345,7 +377,7 @@ Writing the surface in pieces, or the centre line alone (`[output] formats = ["v
 would lower it; not done here.
 
 **Noise.** Measured while other agents' jobs shared the 2 cores of this machine (load
-average 7–13 for the 2³–10³ rows, 3–7 for the 22³ ones): every time is inflated and noisy
+average 7–13 for the 2³ and 5³ rows, 5–6 for the 10³ ones, 3–7 for the 22³ ones): every time is inflated and noisy
 (±30 % and more; the 2-rank runs suffer most, since their ranks wait for each other), and
 each size was run once. Ratios between neighbouring rows are more trustworthy than the
 absolute seconds; rerun `make bench-frame-scaling` on a quiet machine."""
