@@ -1,0 +1,140 @@
+"""Energy bookkeeping of a transient run, every step.
+
+Kinetic T, strain Π, work of loads and of prescribed support motion (trapezoidal rule on
+force · increment, reactions from the residual), Rayleigh dissipation; what is left is the
+integrator's numerical dissipation.
+"""
+
+import numpy as np
+
+from .dofs import constrained_dofs, owned_size
+
+
+def _assemble_scalar(form):
+    """``dolfinx.fem.assemble_scalar(form)`` (the same call), its import made once."""
+    from dolfinx import fem
+
+    global _assemble_scalar
+    _assemble_scalar = fem.assemble_scalar
+    return fem.assemble_scalar(form)
+
+
+class EnergyBalance:
+    """Kinetic and strain energy, work of loads and supports, and dissipation, step by step.
+
+    Works are trapezoidal sums of (force at t_n + force at t_{n+1})/2 · Δq over the dofs;
+    the supports' forces are the reactions (the residual without boundary conditions, on
+    the constrained dofs), assembled only if a support moves (else they do no work).
+
+    Args:
+        dyn: the :class:`Dynamics`.
+        residual: its residual ``dyn.F``, compiled (the Newton solver's).
+    """
+
+    def __init__(self, dyn, residual):
+        import dolfinx.fem.petsc as fp
+
+        from ..solvers.forms import compile_form
+
+        self.dyn, m = dyn, dyn.model
+        self.T = compile_form(dyn.kinetic)
+        self.Pi = compile_form(m.Pi)
+        self.P = compile_form(dyn.power) if dyn.power is not None else None
+        self.f_loads = compile_form(dyn.loads) if dyn.loads is not None else None
+        self.momenta = [compile_form(f) for f in dyn.momenta]
+        self.residual = residual
+        self.moving = any(s.timed for s in m.spec.supports)
+        # supports in local axes: penalties whose target moves with f(t); their work is
+        # ∫ ∂Π/∂f df (trapezoidal), the rest of the support work is reaction · Δq
+        self.penalty_motion = [(compile_form(g), c) for g, c in m.penalty_motion]
+        self.vec = fp.create_vector(self.residual)
+        self.n_owned = owned_size(m.W)
+        mask = np.zeros(len(m.w.x.array), bool)
+        mask[constrained_dofs(m.bcs)] = True
+        self.mask = mask[: self.n_owned]  # constrained, owned dofs (as _vector's rows)
+        self._reactions = (np.zeros(self.n_owned), np.zeros(self.n_owned))
+        self._dq, self._mean = np.zeros(self.n_owned), np.zeros(self.n_owned)
+        self.reaction = None
+        self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
+        self.previous = self.initial = None
+        comm = m.comm  # sums over the ranks (none to make on one: a few µs a step saved)
+        self._sum = comm.allreduce if comm.size > 1 else (lambda x: x)
+
+    def scalar(self, form):
+        """Value of a compiled scalar form (e.g. ``T``, ``Pi``) over all ranks. Collective."""
+        return self._sum(_assemble_scalar(form))
+
+    def _vector(self, form):
+        import dolfinx.fem.petsc as fp
+        from petsc4py import PETSc
+
+        with self.vec.localForm() as b:
+            b.set(0.0)
+        fp.assemble_vector(self.vec, form)
+        self.vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        return self.vec.array_r[: self.n_owned].copy()
+
+    def reactions(self, residual=None):
+        """Support reactions at the converged q_{n+1}: call before the state moves on (the
+        residual's rates are expressions of the state at t_n). ``residual``: F there (owned
+        entries), if the Newton solver kept it (else it is assembled)."""
+        if not self.moving:
+            self.reaction = 0.0
+            return
+        F = self._vector(self.residual) if residual is None else residual
+        # F·mask into the one of two arrays that the previous step's reaction is not
+        out = self._reactions[0] if self._reactions[0] is not self.reaction else self._reactions[1]
+        self.reaction = np.multiply(F, self.mask, out=out)
+
+    def record(self, q_old, h):
+        """Energies at the accepted state; ``q_old`` the unknowns at t_n (None at t = 0).
+        The works' sums run in arrays made once (the same operations as ``0.5 * (f_n +
+        f_{n+1})·(q - q_old)``, so the same numbers)."""
+        now = {
+            "loads": self._vector(self.f_loads) if self.f_loads is not None else 0.0,
+            "reaction": self.reaction,
+            "power": self.scalar(self.P) if self.P is not None else 0.0,
+            "penalty": [[self.scalar(g), float(c.value)] for g, c in self.penalty_motion],
+        }
+        if self.previous is not None:
+            n = self.n_owned
+            dq = np.subtract(self.dyn.w_values[:n], q_old[:n], out=self._dq)
+            prev, mean = self.previous, self._mean
+
+            def trapezoid(key):
+                np.add(prev[key], now[key], out=mean)
+                return self._sum(float(np.dot(np.multiply(0.5, mean, out=mean), dq)))
+
+            if self.f_loads is not None:
+                self.values["work_loads"] += trapezoid("loads")
+            if self.moving:
+                self.values["work_supports"] += trapezoid("reaction")
+            for (g0, f0), (g1, f1) in zip(prev.get("penalty") or [], now["penalty"]):
+                self.values["work_supports"] += 0.5 * (g0 + g1) * (f1 - f0)
+            self.values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
+        self.previous = now
+        out = {"kinetic": self.scalar(self.T), "strain": self.scalar(self.Pi), **self.values}
+        if self.momenta:
+            momenta = [self.scalar(f) for f in self.momenta]
+            out["linear_momentum"], out["angular_momentum"] = momenta[:3], momenta[3:]
+        if self.initial is None:
+            self.initial = out["kinetic"] + out["strain"]
+        out["numerical"] = (
+            out["work_loads"]
+            + out["work_supports"]
+            - out["dissipated_damping"]
+            - (out["kinetic"] + out["strain"] - self.initial)
+        )
+        return out
+
+    def get(self):
+        """The energy accounts, for a checkpoint."""
+        return {"values": dict(self.values), "initial": self.initial, "previous": self.previous}
+
+    def set(self, saved):
+        """Restore the energy accounts saved by :meth:`get`."""
+        self.values, self.initial, self.previous = (
+            dict(saved["values"]),
+            saved["initial"],
+            saved["previous"],
+        )
