@@ -195,10 +195,9 @@ class Dynamics:
         scaled by ``tolerance``·(|q_{n+1}| + ``length``) for displacements and
         ``tolerance``·(|q_{n+1}| + 1) for rotations; root mean square over the owned dofs.
         """
-        q = self.model.w.x.array
-        arrays = [f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n)]
-        _, _, qdd = self.scheme.advance(q, *arrays, h)
-        e = h**2 * abs(self.scheme.p.beta - 1 / 6) * (qdd - self.qdd_n.x.array)
+        q = self.w_values
+        _, _, qdd = self.scheme.advance(q, *self.state_values, h)
+        e = h**2 * abs(self.scheme.p.beta - 1 / 6) * (qdd - self.state_values[3])
         scale = tolerance * (np.abs(q) + np.where(self._is_displacement, length, 1.0))
         n = owned_size(self.model.W)
         comm = self.model.comm
