@@ -127,12 +127,9 @@ class EnergyBalance:
         )
         return out
 
-    def get(self):
-        """The energy accounts, for a checkpoint."""
-        return {"values": dict(self.values), "initial": self.initial, "previous": self.previous}
-
     def set(self, saved):
-        """Restore the energy accounts saved by :meth:`get`."""
+        """Restore the energy accounts: ``values``, ``initial`` and ``previous`` of a checkpoint
+        (:func:`~beamfx.analyses.transient_checkpoint.restore_state`)."""
         self.values, self.initial, self.previous = (
             dict(saved["values"]),
             saved["initial"],
