@@ -17,6 +17,7 @@ from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
 from ..spec import DOF_NAMES
 from .dofs import owned_size, point_displacement, point_displacement_dofs, subspace_dofs
+from .mixed import owned_force_dofs
 from .static import state_dependent_loads, state_sizes
 
 
@@ -129,7 +130,7 @@ def trace_path(
         *(model.F, model.J, model.w, model.load_factor, model.bcs, prefix, options, settings),
         norm_dofs=u_dofs,
         sizes=state_sizes(model),
-        force_dofs=force_dofs(model),
+        force_dofs=owned_force_dofs(model),
     )
     compile_time = compile_seconds[0] - c0
     path, record = _recorder(model, dofs, on_step)
@@ -151,16 +152,6 @@ def trace_path(
     return ContinuationResult(
         tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
     )
-
-
-def force_dofs(model):
-    """Local indices of the mixed formulation's section force unknowns (None in the
-    displacement form): the arc length measures the displacements only, and the inertia and
-    the eigenvector of a critical point are those of the kinematic unknowns
-    (:class:`~beamfx.solvers.arclength.ArcLengthSolver`)."""
-    if not getattr(model, "mixed", False):
-        return None
-    return subspace_dofs(model.W, model.force_index)
 
 
 def _control(spec, control_point, displacement_limit):
