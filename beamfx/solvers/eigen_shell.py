@@ -163,12 +163,20 @@ def _apply(op, mats):
     def apply(lam, x):
         total = np.zeros(len(x), dtype=complex)
         for k, A in enumerate(mats):
-            Ax = op.times(A, x.real, op.c).getArray().copy()
-            Ax = Ax + 1j * op.times(A, x.imag, op.c).getArray()
-            total += lam ** (k + 1) * Ax
+            total += lam ** (k + 1) * _complex_mult(A, x, op.a, op.c)
         return total
 
     return apply
+
+
+def _complex_mult(A, v, x, y):
+    """A v for a complex array ``v`` (local part), through the work Vecs ``x`` and ``y``."""
+    x.array[:] = v.real
+    A.mult(x, y)
+    re = y.getArray().copy()
+    x.array[:] = v.imag
+    A.mult(x, y)
+    return re + 1j * y.getArray()
 
 
 def backward_errors(K, terms, values, vectors):
@@ -180,18 +188,9 @@ def backward_errors(K, terms, values, vectors):
     mats = (K, *terms)
     norms = [A.norm(PETSc.NormType.FROBENIUS) for A in mats]
     x, y = K.createVecs()
-
-    def times(A, v):
-        x.array[:] = v.real
-        A.mult(x, y)
-        re = y.getArray().copy()
-        x.array[:] = v.imag
-        A.mult(x, y)
-        return re + 1j * y.getArray()
-
     out = []
     for lam, v in zip(values, vectors):
-        r = sum(lam**k * times(A, v) for k, A in enumerate(mats))
+        r = sum(lam**k * _complex_mult(A, v, x, y) for k, A in enumerate(mats))
         num = comm.allreduce(float(np.vdot(r, r).real))
         den = comm.allreduce(float(np.vdot(v, v).real))
         scale = sum(abs(lam) ** k * a for k, a in enumerate(norms))
