@@ -37,6 +37,8 @@ def eigenvalue_floor(K, M, v):
     """Round-off of the eigenvalue μ of K v = μ M v with the (complex, local) eigenvector
     ``v``: :data:`ROUNDOFF_FACTOR` ε |v|ᵀ|K||v| / |vᴴ M v| (first-order perturbation of μ by
     an entrywise relative error ε of K; |K| its entries in absolute value). Collective."""
+    from ..solvers.eigen_shell import complex_mult
+
     comm = K.getComm().tompi4py()
     rows, cols, vals = K.getValuesCSR()
     A = K.duplicate(copy=True)
@@ -46,12 +48,7 @@ def eigenvalue_floor(K, M, v):
     x.array[:] = np.abs(v)
     A.mult(x, y)
     top = comm.allreduce(float(np.dot(np.abs(v), y.getArray())))
-    x.array[:] = v.real
-    M.mult(x, y)
-    Mv = y.getArray().copy()
-    x.array[:] = v.imag
-    M.mult(x, y)
-    Mv = Mv + 1j * y.getArray()
+    Mv = complex_mult(M, v, x, y)
     bottom = abs(comm.allreduce(complex(np.vdot(v, Mv))))
     for obj in (A, x, y):
         obj.destroy()

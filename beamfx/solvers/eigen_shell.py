@@ -163,13 +163,13 @@ def _apply(op, mats):
     def apply(lam, x):
         total = np.zeros(len(x), dtype=complex)
         for k, A in enumerate(mats):
-            total += lam ** (k + 1) * _complex_mult(A, x, op.a, op.c)
+            total += lam ** (k + 1) * complex_mult(A, x, op.a, op.c)
         return total
 
     return apply
 
 
-def _complex_mult(A, v, x, y):
+def complex_mult(A, v, x, y):
     """A v for a complex array ``v`` (local part), through the work Vecs ``x`` and ``y``."""
     x.array[:] = v.real
     A.mult(x, y)
@@ -190,7 +190,7 @@ def backward_errors(K, terms, values, vectors):
     x, y = K.createVecs()
     out = []
     for lam, v in zip(values, vectors):
-        r = sum(lam**k * _complex_mult(A, v, x, y) for k, A in enumerate(mats))
+        r = sum(lam**k * complex_mult(A, v, x, y) for k, A in enumerate(mats))
         num = comm.allreduce(float(np.vdot(r, r).real))
         den = comm.allreduce(float(np.vdot(v, v).real))
         scale = sum(abs(lam) ** k * a for k, a in enumerate(norms))
