@@ -324,10 +324,9 @@ cells are grouped by one sort, the names indexed once, the section values cached
 and length, each member's element breaks computed once (not for the overlap check and again
 for the node list); the answers are bit-identical (fields, probes, reactions and the written
 .vtu files of a 3³ lattice). At 22³ cells (10⁶ unknowns) reading the scene and building the
-model take 33 s (linear) and 43 s (finite) of wall-clock time in the rows below (1,547 s
+model take 25 s (linear) and 26 s (finite) of wall-clock time in the rows below (1,547 s
 before, at the load of the first 10⁶ run; 56 CPU s under the profiler), and the model holds
-1.8 GB (these rows ran before the element breaks were computed once, 15 % of the build at
-14³). What is left is linear in the members but Python per member: the mesh's vertex list
+1.8 GB. What is left is linear in the members but Python per member: the mesh's vertex list
 and overlap check, the joint search.
 
 **The two growths of the cost per unknown** (the 2³–22³ rows: CPU per unknown and Newton
@@ -359,13 +358,21 @@ average 5–6 on 2 cores):
 | 14³ after | 0.0150 | 0.0327 | 0.00009 | 0.027 | 0.19 | 5.66 | 5.67 |
 
 The residual assembly per unknown is now flat (60 and 66 ns at 10³ and 14³, against 620 and
-1,220 ns before); the 22³ rows below were measured before these changes and still hold both
-growths. Finite kinematics at 10³ (97,727 unknowns, 3 Newton iterations): residual 0.054 →
+1,220 ns before); every row below was measured after these changes. Finite kinematics at 10³ (97,727 unknowns, 3 Newton iterations): residual 0.054 →
 0.0085, load scale 0.105 → 0.017, condition 0.050 → 0.00005 CPU s; what is left of its
 "other" (0.15 s per iteration) is mostly the round-off floor of Newton's test, once per solve
 (`AbsoluteTangent.floor`: |K| copied from the tangent's CSR and multiplied, 0.42 s), linear
-in the entries. The 10³ rows below were re-measured with these changes; the 2³, 5³ and 22³
-rows were not.
+in the entries.
+
+**What is left of the growth** (the rows below, a quiet machine): from 10⁴ to 10⁶ unknowns
+the cost per unknown and Newton iteration of the iterative rows grows 2.3 times (linear) and
+2.0 times (finite), from 10⁵ to 10⁶ only 1.33 and 1.19 times. The CG iterations stay flat
+(48–50, 151–154); the growth is the cost of one CG iteration per unknown (linear: 0.19 µs at
+11,286 unknowns, 0.37 at 83,766, 0.49 at 857,478). The likely cause, not measured with
+hardware counters: the 5³ matrix and its BoomerAMG hierarchy (a few MB) fit in the
+processor's 32 MB L3 cache, the larger ones stream from memory, where a sparse
+matrix-vector product is bound by bandwidth. So the cost per unknown is roughly constant from
+10⁵ up and about doubles once the problem leaves the cache.
 
 **The frame's memory.** The swept surface of the ParaView frame has 160 points per element
 (32 around the circle at 5 stations) with their u, N and M: writing it took 1.6 GB at 14³
@@ -376,11 +383,9 @@ finite, 1 rank; the first 10⁶ run's 16.4 GB was the frame on top of the solver
 Writing the surface in pieces, or the centre line alone (`[output] formats = ["vtu"]`),
 would lower it; not done here.
 
-**Noise.** Measured while other agents' jobs shared the 2 cores of this machine (load
-average 7–13 for the 2³ and 5³ rows, 5–6 for the 10³ ones, 3–7 for the 22³ ones): every time is inflated and noisy
-(±30 % and more; the 2-rank runs suffer most, since their ranks wait for each other), and
-each size was run once. Ratios between neighbouring rows are more trustworthy than the
-absolute seconds; rerun `make bench-frame-scaling` on a quiet machine."""
+**Noise.** Every row was re-measured on 24 Nov 2026 between 09:38 and 09:53 UTC on a quiet
+machine (load average 0.0–2.3; the earlier versions of this page ran at 3–13), each size once;
+2 ranks share the machine's 2 cores, so a 2-rank row has no core to spare for the system."""
 
 
 def report(folder, notes=SETUP):
