@@ -101,9 +101,11 @@ def free_shift(K, M, forces=None, length=None):
 
 def _min_ratio(comm, k, m):
     """The smallest k_i / m_i over the rows with mass and stiffness (all ranks; inf if none)."""
+    from mpi4py import MPI
+
     ratio = k[m > 0] / m[m > 0]
     ratio = ratio[ratio > 0]
-    return comm.allreduce(np.min(ratio) if len(ratio) else np.inf, op=_mpi_min())
+    return comm.allreduce(np.min(ratio) if len(ratio) else np.inf, op=MPI.MIN)
 
 
 def bending_scale(K, m, forces, length):
@@ -113,6 +115,8 @@ def bending_scale(K, m, forces, length):
     times ``length``² (h). In the rigid limit a translation moves with the rotations; this
     is the highest bending ω² of the mesh, so 1e-6 of it lies below the lowest elastic ω² of
     any mesh one would run. Collective."""
+    from mpi4py import MPI
+
     comm = K.getComm().tompi4py()
     start = K.getOwnershipRange()[0]
     ai, aj, av = K.getValuesCSR()
@@ -126,8 +130,8 @@ def bending_scale(K, m, forces, length):
     local_forces = forces - start
     owned[local_forces[(local_forces >= 0) & (local_forces < len(owned))]] = False
     keep = owned & coupled & (d > 0) & (m == 0)
-    k = comm.allreduce(np.min(d[keep]) if keep.any() else np.inf, op=_mpi_min())
-    top = comm.allreduce(float(np.max(m, initial=0.0)), op=_mpi_max())
+    k = comm.allreduce(np.min(d[keep]) if keep.any() else np.inf, op=MPI.MIN)
+    top = comm.allreduce(float(np.max(m, initial=0.0)), op=MPI.MAX)
     return k / (top * length**2) if top > 0 else np.inf
 
 
@@ -161,18 +165,6 @@ def row_stiffness(K, skip=None):
     out = d[start : start + len(ai) - 1].copy()
     np.maximum.at(out, rows, coupled)
     return out
-
-
-def _mpi_min():
-    from mpi4py import MPI
-
-    return MPI.MIN
-
-
-def _mpi_max():
-    from mpi4py import MPI
-
-    return MPI.MAX
 
 
 def to_functions(model, vectors):
