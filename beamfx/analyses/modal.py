@@ -159,11 +159,12 @@ def row_stiffness(K, skip=None):
         d[skip] = 0.0
     start = K.getOwnershipRange()[0]
     ai, aj, av = K.getValuesCSR()
-    rows = np.repeat(np.arange(len(ai) - 1), np.diff(ai))
     with np.errstate(divide="ignore", invalid="ignore"):
         coupled = np.where(d[aj] > 0, av**2 / d[aj], 0.0)
     out = d[start : start + len(ai) - 1].copy()
-    np.maximum.at(out, rows, coupled)
+    full = np.diff(ai) > 0  # CSR rows are contiguous: one reduction per row, not maximum.at
+    if len(coupled):
+        out[full] = np.maximum(out[full], np.maximum.reduceat(coupled, ai[:-1][full]))
     return out
 
 
