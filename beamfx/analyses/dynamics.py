@@ -45,6 +45,8 @@ class Dynamics:
         # costs a microsecond, and a step asks for them a dozen times
         self.w_values = w.x.array
         self.state_values = tuple(f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n))
+        # work arrays of predict and accept, made once (no arrays made per step)
+        self._work = tuple(np.empty_like(self.w_values) for _ in range(3))
         # dofs per node: displacement (with the nodes' reference positions) and rotation
         V_u, u_dofs = W.sub(0).collapse()
         self.u_dofs = np.asarray(u_dofs).reshape(-1, kin.displacement_size)
@@ -159,16 +161,18 @@ class Dynamics:
         values of the supports at t_{n+1} (a mismatch there would start Newton from a state
         with a sudden strain at the support)."""
         q_n, v_n, a_n, _ = self.state_values
-        self.w_values[:] = self.scheme.predict(q_n, v_n, a_n, h)
-        _set_bc(self.w_values, self.model.bcs, None, 1.0)  # fem.set_bc's call, no wrapper
+        w, tmp = self.w_values, self._work[0]
+        # AlphaStep.predict in place (the same operations): q_n + h v_n + (h² ½) a_n
+        np.add(q_n, np.multiply(h, v_n, out=tmp), out=w)
+        np.add(w, np.multiply(h**2 * 0.5, a_n, out=tmp), out=w)
+        _set_bc(w, self.model.bcs, None, 1.0)  # fem.set_bc's call, no wrapper
 
     def accept(self, h):
         """Move the converged q_{n+1} (in the model's unknowns) into the state at t_n."""
-        q_n, v_n, a_n, qdd_n = self.state_values
-        v_n[:], a_n[:], qdd_n[:] = self.scheme.advance(self.w_values, *self.state_values, h)
+        _advance_in_place(self.scheme.p, h, self.w_values, self.state_values, self._work)
         if self.strain_history:
             self.strain_history.accept(h)
-        q_n[:] = self.w_values
+        self.state_values[0][:] = self.w_values  # q_n
         if self.project_rates:
             self._tangent_rates()
 
@@ -216,6 +220,29 @@ class Dynamics:
         self.model.w.x.array[:] = self.q_n.x.array
         if self.strain_history:
             self.strain_history.set_state(arrays)
+
+
+def _advance_in_place(p, h, q, state, work):
+    """:meth:`AlphaStep.advance <beamfx.solvers.integrators.AlphaStep.advance>` of the
+    converged q_{n+1} = ``q`` with parameters ``p``, written into the ``state`` arrays (q_n,
+    v_n, a_n, q̈_n; q_n is left alone) through the three ``work`` arrays: the same
+    floating-point operations in the same order (so the same numbers, bit for bit), with no
+    array made (a step made sixteen)."""
+    _, v_n, a_n, qdd_n = state
+    a, tmp, tmp2 = work
+    # a = (q - q_n - h v_n - (h² (½ - β)) a_n) / (β h²)
+    np.subtract(q, state[0], out=a)
+    np.subtract(a, np.multiply(h, v_n, out=tmp), out=a)
+    np.subtract(a, np.multiply(h**2 * (0.5 - p.beta), a_n, out=tmp), out=a)
+    np.divide(a, p.beta * h**2, out=a)
+    # q̈ = ((1 - α_m) a + α_m a_n - α_f q̈_n) / (1 - α_f), before a_n and q̈_n move on
+    np.add(np.multiply(1 - p.alpha_m, a, out=tmp), np.multiply(p.alpha_m, a_n, out=tmp2), out=tmp)
+    np.subtract(tmp, np.multiply(p.alpha_f, qdd_n, out=tmp2), out=tmp)
+    np.divide(tmp, 1 - p.alpha_f, out=qdd_n)
+    # v = v_n + (h (1 - γ)) a_n + (h γ) a
+    np.add(v_n, np.multiply(h * (1 - p.gamma), a_n, out=tmp), out=v_n)
+    np.add(v_n, np.multiply(h * p.gamma, a, out=tmp), out=v_n)
+    a_n[:] = a
 
 
 def _set_bc(*args):

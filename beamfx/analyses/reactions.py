@@ -89,6 +89,13 @@ def _cross(a, b):
     return np.column_stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
 
 
+def _moment_about(moment, x, force):
+    """``moment - x × force`` of three-vectors, as a list: :func:`_cross`'s products and
+    differences in plain floats (the same IEEE operations, without its arrays)."""
+    (m0, m1, m2), (x0, x1, x2), (f0, f1, f2) = moment.tolist(), x.tolist(), force.tolist()
+    return [m0 - (x1 * f2 - x2 * f1), m1 - (x2 * f0 - x0 * f2), m2 - (x0 * f1 - x1 * f0)]
+
+
 def _nodal_moments(model, layout, r):
     """Moment (global axes) of the rotation residual rows ``r`` at each owned rotation node."""
     kin = model.kin
@@ -258,10 +265,10 @@ class ReactionRecovery:
             held, ground = total[20 * i : 20 * i + 8], total[20 * i + 8 : 20 * i + 16]
             p = total[20 * i + 16 : 20 * i + 20]  # Σ position, count (one rank has it)
             force, moment = held[:3] + ground[:3], held[3:6] + ground[3:6]
-            sums += np.r_[force, moment]
+            sums[:3] += force
+            sums[3:] += moment
             xp = p[:3] / max(p[3], 1)
-            about = moment - _cross(xp[None], force[None])[0]
-            out[at] = Reaction(force.tolist(), about.tolist(), xp.tolist())
+            out[at] = Reaction(force.tolist(), _moment_about(moment, xp, force), xp.tolist())
         k = 20 * len(self.points)
         return out, sums, [total[k + 8 * j : k + 8 * j + 8] for j in range(len(extra))]
 

@@ -34,6 +34,7 @@ goes (rank 0; the writer a static run uses too, :mod:`beamfx.io.reaction_files`)
 and the largest values over the run.
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -103,8 +104,8 @@ class TransientReactions:
         )
         fa, ma, fi, mi = applied[:3], applied[3:6], inert[:3], inert[3:6]
         balance = DynamicBalance(
-            float(np.linalg.norm(total[:3] + fa - fi) / max(applied[6] + inert[6], 1e-300)),
-            float(np.linalg.norm(total[3:] + ma - mi) / max(applied[7] + inert[7], 1e-300)),
+            float(_norm(total[:3] + fa - fi) / max(applied[6] + inert[6], 1e-300)),
+            float(_norm(total[3:] + ma - mi) / max(applied[7] + inert[7], 1e-300)),
             fa.tolist(),
             ma.tolist(),
             fi.tolist(),
@@ -112,6 +113,12 @@ class TransientReactions:
             free_residual,
         )
         return reactions, balance
+
+
+def _norm(v):
+    """``np.linalg.norm`` of a vector, as it computes it (the square root of ``v.dot(v)``),
+    without its checks: a float."""
+    return math.sqrt(v.dot(v))
 
 
 def _row(step, time, reactions, balance):
@@ -138,7 +145,7 @@ class Peaks:
         self.rows += 1
         for at, peak in self.points.items():
             for key, vec in (("force", forces[at]), ("moment", moments[at])):
-                size = float(np.linalg.norm(vec))
+                size = _norm(np.asarray(vec, float))
                 if peak[f"{key}_time"] is None or size > peak[key]:
                     peak[key], peak[f"{key}_time"] = size, float(time)
         for key, value in zip(("force", "moment"), balance):
