@@ -67,6 +67,7 @@ class _Layout(NamedTuple):
     axes: list  # global axis of each displacement component
     X: np.ndarray  # (n, 3) reference position of each displacement node
     q: np.ndarray  # (m, rotation comps) W dof indices
+    normal: np.ndarray | None = None  # a planar model's normal (global axes)
 
 
 def _layout(model):
@@ -79,8 +80,10 @@ def _layout(model):
         dofs = np.asarray(dofs).reshape(-1, n)
         keep = dofs[:, 0] < owned
         rows.append((dofs[keep], V.tabulate_dof_coordinates()[keep] if sub == 0 else None))
-    axes = [DOF_NAMES.index(name) for name, sub, _ in model.kin.dofs() if sub == 0]
-    return _Layout(rows[0][0], axes, rows[0][1], rows[1][0])
+    kin = model.kin
+    axes = [DOF_NAMES.index(name) for name, sub, _ in kin.dofs() if sub == 0]
+    normal = np.eye(3)[DOF_NAMES.index(kin.dofs()[2][0]) - 3] if kin.plane else None
+    return _Layout(rows[0][0], axes, rows[0][1], rows[1][0], normal)
 
 
 def _cross(a, b):
@@ -100,8 +103,7 @@ def _nodal_moments(model, layout, r):
     """Moment (global axes) of the rotation residual rows ``r`` at each owned rotation node."""
     kin = model.kin
     if kin.plane:
-        normal = np.eye(3)[DOF_NAMES.index(kin.dofs()[2][0]) - 3]
-        return r[:, :1] * normal
+        return r[:, :1] * layout.normal
     if not kin.finite:
         return r
     q = model.w.x.array[layout.q]
@@ -278,7 +280,8 @@ def _near(layout, dofs):
     ``layout.u``: a point's resultant over them is its resultant over all nodes."""
     u_rows = np.flatnonzero(np.isin(layout.u, dofs).any(1))
     q_rows = np.flatnonzero(np.isin(layout.q, dofs).any(1))
-    near = _Layout(layout.u[u_rows], layout.axes, layout.X[u_rows], layout.q[q_rows])
+    u, X, q = layout.u[u_rows], layout.X[u_rows], layout.q[q_rows]
+    near = _Layout(u, layout.axes, X, q, layout.normal)
     return near, u_rows
 
 

@@ -76,6 +76,7 @@ class TransientReactions:
         self.inertia = compile_form(dyn.inertia_forces)
         self.loads = loads
         self.free = np.ones(owned_size(dyn.model.W), bool)  # owned, not held
+        self.size = len(dyn.model.w.x.array)  # owned and ghost entries
         held = constrained_dofs(dyn.model.bcs)
         self.free[held[held < len(self.free)]] = False
 
@@ -83,11 +84,10 @@ class TransientReactions:
         """``({point: Reaction}, DynamicBalance)``; ``residual``: the step's residual (owned
         entries, as assembled before the conditions), else assembled. Collective."""
         rec, model = self.recovery, self.model
-        n = len(model.w.x.array)
         if residual is None:
             R = rec.assemble(self.residual)
         else:
-            R = np.zeros(n)
+            R = np.zeros(self.size)
             R[: len(residual)] = residual
         inertia = rec.assemble(self.inertia)
         if self.loads is None:
