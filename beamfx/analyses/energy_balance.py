@@ -54,6 +54,7 @@ class EnergyBalance:
         self.mask = mask[: self.n_owned]  # constrained, owned dofs (as _vector's rows)
         self._reactions = (np.zeros(self.n_owned), np.zeros(self.n_owned))
         self._dq, self._mean = np.zeros(self.n_owned), np.zeros(self.n_owned)
+        self._w_owned = dyn.w_values[: self.n_owned]  # a view of the unknowns, kept
         self.reaction = None
         self.values = dict.fromkeys(("work_loads", "work_supports", "dissipated_damping"), 0.0)
         self.previous = self.initial = None
@@ -96,22 +97,17 @@ class EnergyBalance:
             "power": self.scalar(self.P) if self.P is not None else 0.0,
             "penalty": [[self.scalar(g), float(c.value)] for g, c in self.penalty_motion],
         }
-        if self.previous is not None:
-            n = self.n_owned
-            dq = np.subtract(self.dyn.w_values[:n], q_old[:n], out=self._dq)
-            prev, mean = self.previous, self._mean
-
-            def trapezoid(key):
-                np.add(prev[key], now[key], out=mean)
-                return self._sum(float(np.dot(np.multiply(0.5, mean, out=mean), dq)))
-
+        prev, values = self.previous, self.values
+        if prev is not None:
+            if self.f_loads is not None or self.moving:  # Δq, owned entries
+                np.subtract(self._w_owned, q_old[: self.n_owned], out=self._dq)
             if self.f_loads is not None:
-                self.values["work_loads"] += trapezoid("loads")
+                values["work_loads"] += self._trapezoid(prev["loads"], now["loads"])
             if self.moving:
-                self.values["work_supports"] += trapezoid("reaction")
+                values["work_supports"] += self._trapezoid(prev["reaction"], now["reaction"])
             for (g0, f0), (g1, f1) in zip(prev.get("penalty") or [], now["penalty"]):
-                self.values["work_supports"] += 0.5 * (g0 + g1) * (f1 - f0)
-            self.values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
+                values["work_supports"] += 0.5 * (g0 + g1) * (f1 - f0)
+            values["dissipated_damping"] += 0.5 * (prev["power"] + now["power"]) * h
         self.previous = now
         out = {"kinetic": self.scalar(self.T), "strain": self.scalar(self.Pi), **self.values}
         if self.momenta:
@@ -126,6 +122,11 @@ class EnergyBalance:
             - (out["kinetic"] + out["strain"] - self.initial)
         )
         return out
+
+    def _trapezoid(self, before, after):
+        """0.5 (``before`` + ``after``) · Δq summed over the ranks, in the arrays made once."""
+        mean = np.add(before, after, out=self._mean)
+        return self._sum(float(np.dot(np.multiply(0.5, mean, out=mean), self._dq)))
 
     def set(self, saved):
         """Restore the energy accounts: ``values``, ``initial`` and ``previous`` of a checkpoint
