@@ -307,14 +307,15 @@ def summary_template(grid, pieces, folder):
 
 def write_summary(path, template):
     """The ``.pvtu`` at ``path``: the ``template`` with the pieces of this frame, named
-    ``<stem>_<r>.vtu`` after the file (the same arrays in every frame of a series)."""
+    ``<stem>_<r>.vtu`` after the file (the same arrays in every frame of a series). Written
+    under its own name, like the pieces (:class:`GridWriter`): the series' index names the
+    frame only after this. Through a temporary file and a rename it cost 0.10-0.14 ms a frame
+    here, written in place about as much for a new file and 0.013 ms over an earlier run's.
+    """
     path = os.fspath(path)
     stem = os.path.splitext(os.path.basename(path))[0]
     text = template.replace(f'Source="{PLACEHOLDER}_'.encode(), f'Source="{stem}_'.encode())
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "wb") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    write_in_place(path, text)
 
 
 __all__ = [
