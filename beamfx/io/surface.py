@@ -8,6 +8,8 @@ closed by an end cap at its two ends. The samples are the k + 1 nodes of each el
 and M by the element's Lagrange polynomials through its nodes (exact: u and the P_k geometry
 are P_k, recovered N and M are of degree k − 1), the section axes the same way followed by
 the nearest rotation (polar decomposition), which is accurate to the interpolation error.
+The cells are the same at every frame of a run: :class:`SweptSurface` makes them once
+(:mod:`beamfx.io.surface_cells`) and a frame only its points and point arrays (:func:`sweep`).
 
 Outlines, a list of closed loops each an (n, 2) array of (y, z), counter-clockwise about e1:
 
