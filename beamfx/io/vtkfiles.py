@@ -25,10 +25,10 @@ but doubles VTK's cost of a frame; ParaView 5.11 (Debian 12, the pvpython checks
 and the vtk wheel read LZ4.
 
 Under MPI every rank writes its own piece ``name_NNNN_R.vtu`` (the cells it owns) and rank 0
-the summary ``name_NNNN.pvtu``; nothing is gathered. Without an MPI controller (the pip wheel has none)
-VTK's parallel writer lists only the pieces it wrote itself, so once per series rank 0 lets
-it write the summary of all ranks' pieces from a one-point stand-in of its own piece in a
-scratch folder; every frame's summary is that file with the frame's piece names.
+the summary ``name_NNNN.pvtu``; nothing is gathered. Without an MPI controller (the pip wheel
+has none) VTK's parallel writer lists only the pieces it wrote itself, so once per series rank
+0 lets it write the summary of all ranks' pieces from a one-point stand-in of its own piece in
+a scratch folder; every frame's summary is that file with the frame's piece names.
 
 The time series (``.pvd`` index and frame files) are in :mod:`beamfx.io.series`.
 
