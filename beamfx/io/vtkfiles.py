@@ -10,19 +10,20 @@ finds them through the series' index, which names a frame only after its files a
 (the rename cost as much as the file's creation: 0.15-0.4 ms a frame here).
 
 Compression is LZ4, not zlib. Measured on the frames of a real state (flying spaghetti, 16 P2
-elements, a rectangle section; VTK's Write alone, CPU, the arrays changed as in a frame):
+elements, a rectangle section; VTK's Write alone, CPU, the arrays changed as in a frame, with
+:func:`thread_count_once`):
 
 ========================  ============  ============  ============  ============
 frame                     none          LZ4           zlib 1        zlib 6
 ========================  ============  ============  ============  ============
-centre line (48 points)   0.19 ms 12.8k 0.21 ms 11.8k 0.38 ms 10.3k 0.53 ms 10.2k
-surface (320 points)      0.23 ms 47.5k 0.26 ms 28.0k 0.54 ms 16.3k 0.95 ms 15.9k
-reactions (1 point)       0.07 ms 1.6k  0.08 ms 1.8k  0.09 ms 1.8k  0.09 ms 1.8k
+centre line (48 points)   0.06 ms 12.8k 0.07 ms 11.8k 0.24 ms 10.3k 0.39 ms 10.2k
+surface (320 points)      0.05 ms 47.5k 0.08 ms 28.0k 0.33 ms 16.3k 0.75 ms 15.9k
+reactions (1 point)       0.03 ms 1.6k  0.04 ms 1.8k  0.05 ms 1.8k  0.05 ms 1.8k
 ========================  ============  ============  ============  ============
 
-(zlib levels 2-5 lie between; bytes in thousands.) zlib halves the surface files against LZ4
-but doubles VTK's cost of a frame; ParaView 5.11 (Debian 12, the pvpython checks of the tests)
-and the vtk wheel read LZ4.
+(zlib levels 2-5 lie between; bytes in thousands.) zlib makes the surface files 40 % smaller
+than LZ4 but VTK's writing 3-4 times dearer; ParaView 5.11 (Debian 12, the pvpython checks of
+the tests) and the vtk wheel read LZ4.
 
 Under MPI every rank writes its own piece ``name_NNNN_R.vtu`` (the cells it owns) and rank 0
 the summary ``name_NNNN.pvtu``; nothing is gathered. Without an MPI controller (the pip wheel
