@@ -8,6 +8,8 @@ closed by an end cap at its two ends. The samples are the k + 1 nodes of each el
 and M by the element's Lagrange polynomials through its nodes (exact: u and the P_k geometry
 are P_k, recovered N and M are of degree k − 1), the section axes the same way followed by
 the nearest rotation (polar decomposition), which is accurate to the interpolation error.
+The cells are the same at every frame of a run: :class:`SweptSurface` makes them once
+(:mod:`beamfx.io.surface_cells`) and a frame only its points and point arrays (:func:`sweep`).
 
 Outlines, a list of closed loops each an (n, 2) array of (y, z), counter-clockwise about e1:
 
@@ -34,10 +36,12 @@ from typing import NamedTuple
 import numpy as np
 
 from ._sections import lagrange_matrix
-from .vtkfiles import VTK_POLYGON, VTK_QUAD
+from .surface_cells import join, surface_cells
+from .vtkfiles import VTK_POLYGON, VTK_QUAD  # noqa: F401 (the surface's cell types)
 
 CIRCLE_SEGMENTS = 32
 SAMPLE_ARRAYS = ("u", "N", "M")
+AXES = ("e1", "e2", "e3")
 
 
 def circle_loop(d, segments=CIRCLE_SEGMENTS, clockwise=False):
@@ -104,13 +108,15 @@ def refine(fields, degree, subdivisions=4):
     k = degree
     n_el = len(fields["X"]) // (k + 1)
     A = _refinement_matrix(k, subdivisions)
-
-    def per_element(a):
-        return np.einsum("sn,en...->es...", A, np.asarray(a).reshape(n_el, k + 1, -1))
-
-    out = {name: per_element(fields[name]) for name in SAMPLE_ARRAYS}
-    out["x"] = per_element(np.asarray(fields["X"]) + np.asarray(fields["u"]))
-    axes = np.stack([per_element(fields[e]) for e in ("e1", "e2", "e3")], axis=-1)
+    # one product for all the arrays side by side (one per array cost 7 times more; each
+    # value is the same sum of the same products)
+    columns = [np.asarray(fields[name]).reshape(-1, 3) for name in (*SAMPLE_ARRAYS, *AXES)]
+    columns.append((np.asarray(fields["X"]) + np.asarray(fields["u"])).reshape(-1, 3))
+    values = np.einsum("sn,enc->esc", A, np.concatenate(columns, axis=1).reshape(n_el, k + 1, -1))
+    out = {name: values[..., 3 * i : 3 * i + 3] for i, name in enumerate(SAMPLE_ARRAYS)}
+    out["x"] = values[..., -3:]
+    n = 3 * len(SAMPLE_ARRAYS)  # then e1, e2, e3: as the rows of each (3, 3), so transposed
+    axes = values[..., n : n + 9].reshape(*values.shape[:2], 3, 3).swapaxes(-1, -2)
     U, _, Vt = np.linalg.svd(axes)  # nearest rotation: U Vᵀ (the sign is safe: axes ≈ R)
     out["axes"] = U @ Vt
     beam = np.asarray(fields["beam"])
@@ -142,54 +148,54 @@ class SurfaceMesh(NamedTuple):
         return np.split(self.connectivity, self.offsets[1:-1]) if len(self.types) else []
 
 
-def _cap(loops, ring, flip):
-    """End cap cells of the section ring starting at point ``ring``: one polygon, or for a
-    tube a ring of quads between the outer and (clockwise) inner loop; ``flip`` reverses
-    them (the start of a beam faces backwards)."""
-    if len(loops) == 1:
-        ids = ring + np.arange(len(loops[0]))
-        return [ids[::-1] if flip else ids]
-    if len(loops) == 2 and len(loops[0]) == len(loops[1]):
-        n = len(loops[0])
-        j = np.arange(n)
-        outer, inner = ring + j, ring + n + j[::-1]  # inner loop runs clockwise: re-align
-        quads = np.stack([outer, np.roll(outer, -1), np.roll(inner, -1), inner], axis=1)
-        return list(quads[:, ::-1] if flip else quads)
-    return []
+def sweep(samples, cells):
+    """The :class:`SurfaceMesh` of the :func:`refine` ``samples`` on :func:`surface_cells`
+    ``cells``: each section's ring placed at x + y e2 + z e3, and u, N, M per ring point."""
+    points, data = [], {name: [] for name in SAMPLE_ARRAYS}
+    for elements, yz in cells.parts:
+        x, axes = samples["x"][elements], samples["axes"][elements]  # (E, S, 3), (E, S, 3, 3)
+        pts = x[:, :, None, :] + yz[None, None, :, 0, None] * axes[:, :, None, :, 1]
+        points.append((pts + yz[None, None, :, 1, None] * axes[:, :, None, :, 2]).reshape(-1, 3))
+        for key in SAMPLE_ARRAYS:
+            data[key].append(np.repeat(samples[key][elements].reshape(-1, 3), len(yz), axis=0))
+    if not points:
+        points = [np.zeros((0, 3))]
+        data = {k: [np.zeros((0, 3))] for k in SAMPLE_ARRAYS}
+    return SurfaceMesh(
+        join(points),
+        cells.connectivity,
+        cells.offsets,
+        cells.types,
+        {k: join(v) for k, v in data.items()},
+        cells.cell_data,
+    )
 
 
-def _sides(loops, n_el, samples, ring, base):
-    """Quads along the beam of ``n_el`` elements whose points start at ``base`` (each element
-    ``samples`` rings of ``ring`` points), element by element: (quads (m, 4), element (m,))."""
-    quads = []
-    e = np.arange(n_el)[:, None, None]
-    i = np.arange(samples - 1)[None, :, None]
-    start = 0
-    for lp in loops:
-        j = np.arange(len(lp))[None, None, :]
-        a = base + (e * samples + i) * ring + start
-        c = a + ring
-        jn = (j + 1) % len(lp)
-        q = np.stack(np.broadcast_arrays(a + j, a + jn, c + jn, c + j), axis=-1)
-        quads.append(q.reshape(n_el, -1, 4))
-        start += len(lp)
-    q = np.concatenate(quads, axis=1)
-    return q.reshape(-1, 4), np.repeat(np.arange(n_el), q.shape[1])
+class SweptSurface:
+    """The surfaces of the frames of a run (:func:`surface_mesh` of each frame's fields): the
+    cells are made once, at the first frame (again only if the elements change); a frame
+    computes its points and point arrays alone.
 
+    Args:
+        degree, beam_names, outlines, subdivisions, ends: as in :func:`surface_mesh`.
+    """
 
-def _element_ends(cell, s_beam, ends):
-    """Booleans (first, last) per element: does it start or end its beam?"""
-    n_el = len(s_beam)
-    if ends is None:  # the first and last element of each beam among these fields
-        first, last = {}, {}
-        for e, b in enumerate(s_beam.tolist()):
-            first.setdefault(b, e)
-            last[b] = e
-        return np.isin(np.arange(n_el), list(first.values())), np.isin(
-            np.arange(n_el), list(last.values())
-        )
-    lo, hi = (np.asarray(a) for a in ends)
-    return cell == lo[s_beam], cell == hi[s_beam]
+    def __init__(self, degree, beam_names, outlines, subdivisions=4, ends=None):
+        self.degree, self.subdivisions = degree, subdivisions
+        self.beam_names, self.outlines, self.ends = beam_names, outlines, ends
+        self.cells, self.key = None, None
+
+    def __call__(self, fields):
+        """The :class:`SurfaceMesh` of ``fields`` (see :func:`surface_mesh`)."""
+        s = refine(fields, self.degree, self.subdivisions)
+        cell = np.asarray(fields.get("cell", np.arange(len(s["beam"]))), dtype=np.int64)
+        key = self.key
+        if key is None or not (np.array_equal(cell, key[0]) and np.array_equal(s["beam"], key[1])):
+            self.cells = surface_cells(
+                cell, s["beam"], self.beam_names, self.outlines, self.subdivisions, self.ends
+            )
+            self.key = (cell, s["beam"])
+        return sweep(s, self.cells)
 
 
 def surface_mesh(fields, degree, beam_names, outlines, subdivisions=4, ends=None):
@@ -209,77 +215,7 @@ def surface_mesh(fields, degree, beam_names, outlines, subdivisions=4, ends=None
     Returns:
         :class:`SurfaceMesh`.
     """
-    s = refine(fields, degree, subdivisions)
-    cell = np.asarray(fields.get("cell", np.arange(len(s["beam"]))), dtype=np.int64)
-    first, last = _element_ends(cell, s["beam"], ends)
-    samples = subdivisions + 1
-    points, cells, sizes, types, element = [], [], [], [], []
-    data = {name: [] for name in SAMPLE_ARRAYS}
-    n_points, of_beam = 0, _beam_elements(s["beam"])
-    for b, name in enumerate(beam_names):
-        loops = outlines.get(name)
-        elements = of_beam.get(b, np.zeros(0, np.int64))
-        if loops is None or not len(elements):
-            continue
-        loops = [np.asarray(lp, float).reshape(-1, 2) for lp in loops]
-        yz = np.concatenate(loops)  # one ring = all loops of a section
-        ring = len(yz)
-        x, axes = s["x"][elements], s["axes"][elements]  # (E, S, 3), (E, S, 3, 3)
-        pts = x[:, :, None, :] + yz[None, None, :, 0, None] * axes[:, :, None, :, 1]
-        points.append((pts + yz[None, None, :, 1, None] * axes[:, :, None, :, 2]).reshape(-1, 3))
-        for key in SAMPLE_ARRAYS:
-            data[key].append(np.repeat(s[key][elements].reshape(-1, 3), ring, axis=0))
-        quads, owner = _sides(loops, len(elements), samples, ring, n_points)
-        cells.append(quads.ravel())
-        sizes.append(np.full(len(quads), 4))
-        types.append(np.full(len(quads), VTK_QUAD))
-        element.append(elements[owner])
-        cap_type = VTK_QUAD if len(loops) == 2 else VTK_POLYGON
-        for flag, flip, shift in ((first, True, 0), (last, False, (samples - 1) * ring)):
-            for local in np.flatnonzero(flag[elements]):
-                caps = _cap(loops, n_points + local * samples * ring + shift, flip)
-                cells.extend(caps)
-                sizes.append([len(c) for c in caps])
-                types.append([cap_type] * len(caps))
-                element.append(np.full(len(caps), elements[local]))
-        n_points += len(elements) * samples * ring
-    if not points:
-        none = np.zeros(0, np.int64)
-        empty = {k: np.zeros((0, 3)) for k in SAMPLE_ARRAYS}
-        return SurfaceMesh(
-            np.zeros((0, 3)),
-            none,
-            np.zeros(1, np.int64),
-            none.astype(np.uint8),
-            empty,
-            {"cell": none, "beam": none},
-        )
-    # each list joined and emptied in turn: its pieces and the whole are not all held at once
-    element = _join(element).astype(np.int64, copy=False)
-    sizes = _join(sizes)
-    return SurfaceMesh(
-        _join(points),
-        _join(cells).astype(np.int64, copy=False),
-        np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
-        _join(types).astype(np.uint8, copy=False),
-        {k: _join(v) for k, v in data.items()},
-        {"cell": cell[element], "beam": s["beam"][element]},
-    )
-
-
-def _join(parts):
-    """``np.concatenate(parts)``, emptying the list ``parts`` (its pieces are freed)."""
-    out = np.concatenate(parts)
-    parts.clear()
-    return out
-
-
-def _beam_elements(beam):
-    """{beam index: its elements in ascending order}: one sort, not a comparison of all
-    elements per beam (O(N²) on a frame of 10⁵ members)."""
-    order = np.argsort(beam, kind="stable")
-    keys, starts = np.unique(beam[order], return_index=True)
-    return dict(zip(keys.tolist(), np.split(order, starts[1:])))
+    return SweptSurface(degree, beam_names, outlines, subdivisions, ends)(fields)
 
 
 def surface_grid(mesh, arrays=SAMPLE_ARRAYS, build=None):

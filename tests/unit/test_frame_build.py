@@ -27,7 +27,7 @@ def test_beam_cells_are_the_cells_of_each_beam_in_order(seed):
 
 def test_surface_elements_by_beam():
     """``_beam_elements`` of the swept surface: each beam's elements in ascending order."""
-    from beamfx.io.surface import _beam_elements
+    from beamfx.io.surface_cells import _beam_elements
 
     beam = np.array([3, 0, 3, 1, 0, 3], dtype=np.int64)
     got = _beam_elements(beam)

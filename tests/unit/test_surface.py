@@ -8,7 +8,15 @@ the material, and the ends are closed.
 import numpy as np
 import pytest
 
-from beamfx.io.surface import VTK_POLYGON, VTK_QUAD, section_outline, surface_mesh
+from beamfx.io._sections import lagrange_matrix
+from beamfx.io.surface import (
+    VTK_POLYGON,
+    VTK_QUAD,
+    SweptSurface,
+    refine,
+    section_outline,
+    surface_mesh,
+)
 
 K, ELEMENTS, SUB = 2, 2, 4
 U = np.array([0.1, 0.2, 0.3])
@@ -99,3 +107,57 @@ def test_general_section_has_no_outline():
     assert section_outline("general") is None
     mesh = surface_mesh(straight_fields(), K, ["b"], {"b": None})
     assert len(mesh.points) == 0 and mesh.cells() == [] and len(mesh.types) == 0
+
+
+def bent_fields(seed, elements=3, k=3):
+    """Nodal fields of ``elements`` elements of degree k with random positions, loads and
+    section axes near random rotations (interpolated axes are not orthonormal)."""
+    rng = np.random.default_rng(seed)
+    n = elements * (k + 1)
+    q, _ = np.linalg.qr(rng.standard_normal((n, 3, 3)))
+    axes = q + 1e-3 * rng.standard_normal((n, 3, 3))
+    fields = {name: rng.standard_normal((n, 3)) for name in ("X", "u", "N", "M")}
+    fields.update({f"e{i + 1}": np.ascontiguousarray(axes[..., i]) for i in range(3)})
+    fields["cell"], fields["beam"] = np.arange(elements), np.zeros(elements, np.int64)
+    return fields
+
+
+def test_refine_is_the_interpolation_of_each_array():
+    """refine's one product of all arrays side by side gives, bit for bit, each array's own
+    interpolation (the sums of the same products), and the nearest rotations of the axes."""
+    k, sub = 3, 4
+    fields = bent_fields(0, k=k)
+    s = refine(fields, k, sub)
+    A = lagrange_matrix(np.linspace(0, 1, k + 1), np.linspace(0, 1, sub + 1))
+
+    def alone(a):
+        return np.einsum("sn,en...->es...", A, np.asarray(a).reshape(-1, k + 1, 3))
+
+    for name in ("u", "N", "M"):
+        assert np.array_equal(s[name], alone(fields[name]))
+    assert np.array_equal(s["x"], alone(fields["X"] + fields["u"]))
+    U, _, Vt = np.linalg.svd(np.stack([alone(fields[e]) for e in ("e1", "e2", "e3")], axis=-1))
+    assert np.array_equal(s["axes"], U @ Vt)
+    assert np.allclose(s["axes"] @ s["axes"].swapaxes(-1, -2), np.eye(3), atol=1e-14)
+
+
+def test_swept_surface_reuses_its_cells_across_frames():
+    """A series' SweptSurface makes its cells once: each frame equals surface_mesh of that
+    frame's fields, with the same cell arrays (read only); other elements make new cells."""
+    outline = {"b": section_outline("tube", d=1.0, d_inner=0.6, segments=8)}
+    swept = SweptSurface(3, ["b"], outline, SUB, ends=([0], [2]))
+    frames = [swept(bent_fields(seed)) for seed in (1, 2)]
+    for seed, mesh in zip((1, 2), frames):
+        fresh = surface_mesh(bent_fields(seed), 3, ["b"], outline, SUB, ends=([0], [2]))
+        for a, b in zip(mesh[:4], fresh[:4]):
+            assert np.array_equal(a, b)
+        for name in ("point_data", "cell_data"):
+            d, e = getattr(mesh, name), getattr(fresh, name)
+            assert d.keys() == e.keys() and all(np.array_equal(d[x], e[x]) for x in d)
+    assert frames[0].connectivity is frames[1].connectivity
+    assert not frames[0].connectivity.flags.writeable
+    part = bent_fields(3)
+    part = {key: v[4:] if key not in ("cell", "beam") else v[1:] for key, v in part.items()}
+    fewer = swept(part)  # elements 1 and 2 only: fewer cells, the end cap only
+    assert len(fewer.types) < len(frames[0].types)
+    assert set(fewer.cell_data["cell"].tolist()) == {1, 2}
