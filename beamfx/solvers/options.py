@@ -49,7 +49,8 @@ _WORD = re.compile(r"[A-Za-z0-9_.+-]{1,64}")
 
 
 #: ``linear`` in ``[solver]``: the linear solver of every Newton iteration, as a preset of
-#: PETSc options (options given beside it win). ``direct``: LU by MUMPS (the default).
+#: PETSc options (options given beside it win). ``direct``: LU by MUMPS (the default; a
+#: serial system of at most :data:`DENSE_LIMIT` unknowns: the dense LU, :func:`use_dense`).
 #: ``iterative``: conjugate gradients preconditioned by BoomerAMG (hypre's algebraic
 #: multigrid) on the unknowns ordered node by node (:mod:`beamfx.solvers.blocked`, so it
 #: coarsens each kind of unknown over the nodes); for a symmetric tangent (dead loads). Why
@@ -76,6 +77,33 @@ def expand_linear(options):
     if preset not in LINEAR:
         raise ValueError(f"linear = {preset!r}: allowed: {', '.join(map(repr, LINEAR))}")
     return {**LINEAR[preset], **options}
+
+
+#: the largest serial system Newton factors by a dense LU (PETSc's seqdense LU: LAPACK getrf,
+#: partial pivoting, so a saddle point's zero diagonal is no obstacle) instead of MUMPS. On
+#: beamfx tangents (planar, 3D, mixed; 9 to 438 unknowns) MUMPS costs 0.1-0.2 ms per
+#: factorisation and solve below 100 unknowns, its set-up and analysis more than the work;
+#: the dense LU costs 3 µs at 9, 7 at 27, 30 at 60 and 100 µs at 100 unknowns, and grows as
+#: n³: the two cross between 110 and 130 unknowns (2 cores shared, noisy; issue 20)
+DENSE_LIMIT = 100
+#: the options of the dense LU (on the converted matrix: :func:`use_dense`)
+DENSE = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "petsc"}
+#: the options by which a user picks the linear solver: any of them given, the dense LU is not
+LINEAR_KEYS = ("ksp_type", "pc_type", "pc_factor_mat_solver_type")
+
+
+def use_dense(options, size, ranks, preset=()):
+    """Whether Newton factors its tangent by the dense LU (:data:`DENSE`): one rank, at most
+    :data:`DENSE_LIMIT` unknowns (``size``), and no linear solver chosen by the user's
+    ``options`` (the scene's, before the ``linear`` preset is expanded) nor by the options
+    ``preset`` (names without prefix already in PETSc's database, e.g. from the command
+    line). ``linear = "direct"`` asks for a direct solve: the dense LU is one."""
+    if ranks > 1 or size > DENSE_LIMIT:
+        return False
+    options = options or {}
+    if options.get("linear", "direct") != "direct":
+        return False
+    return not any(key in options or key in preset for key in LINEAR_KEYS)
 
 
 def is_iterative(options):

@@ -9,7 +9,7 @@ from .assembly import assemble_residual, assemble_tangent, prescribed
 from .blocked import use_node_blocks
 from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
-from .options import expand_linear, petsc_options
+from .options import DENSE, LINEAR_KEYS, expand_linear, petsc_options, use_dense
 
 #: defaults chosen for beams (notes §4): full Newton steps (the bt line search stalls on the
 #: stiff axial term), no divergence stop, LU with MUMPS. The convergence test is beamfx's
@@ -26,10 +26,11 @@ DEFAULT_OPTIONS = {
 }
 
 
-#: PETSc log events that make up the linear solves: (sparse) LU factorisation and the
-#: triangular solves (MUMPS is called through them)
+#: PETSc log events that make up the linear solves: the preconditioner's set-up (the LU
+#: factorisation: MUMPS's analysis and numeric factorisation, or the dense LU, whose
+#: MatLUFactorNum PETSc does not log) and the triangular solves
 LINEAR_EVENTS = {
-    "factorise": ("MatLUFactorSym", "MatLUFactorNum"),
+    "factorise": ("PCSetUp",),
     "triangular_solve": ("MatSolve",),
 }
 
@@ -103,27 +104,36 @@ class NewtonSolver:
         self.b = fp.create_vector(self.F)
         self.A = fp.create_matrix(self.J)
         self.x = w.vector.copy()
+        self.comm = w.function_space.mesh.comm
         self.seconds = {"assemble_F": 0.0, "assemble_J": 0.0, "solve": 0.0, "test": 0.0}
         linear_solve_seconds()  # start PETSc's event log before the first solve
         self._residuals = []
         self.options = {**DEFAULT_OPTIONS, **expand_linear(options)}
+        # a small serial tangent: factored dense (LAPACK) from a copy kept beside the sparse A
+        given = [k for k in LINEAR_KEYS if PETSc.Options().hasName(f"{prefix}{k}")]
+        self.P = None
+        if use_dense(options, self.A.getSize()[0], self.comm.size, given):
+            self.options.update(DENSE)
+            self.P = PETSc.Mat().createDense(self.A.getSizes(), comm=self.comm)
+            self.P.setUp()
         self.atol = float(self.options.get("snes_atol", 0.0))
         self.rtol = float(self.options.get("snes_rtol", 0.0))
         self.force_scale, self.reactions, self.sizes = 0.0, 0.0, None
         self._rows = constrained_rows(bcs, self.b.getLocalSize())
-        self.comm = w.function_space.mesh.comm
         self._kept = None  # (x, F before the conditions, lifted) of the last residual
         self._targets = None  # the prescribed values on the constrained rows, per solve
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
         snes.setFunction(self._residual, self.b)
-        snes.setJacobian(self._jacobian, self.A)
+        snes.setJacobian(self._jacobian, self.A, self.A if self.P is None else self.P)
         snes.setMonitor(lambda s, it, norm: self._residuals.append(norm))
         with petsc_options(prefix, self.options):
             snes.setFromOptions()
             snes.getKSP().setFromOptions()
             self.blocks = use_node_blocks(snes.getKSP(), w)  # AMG on whole beam nodes
+        self.linear_solver = describe(snes.getKSP(), self.P is not None)
+        _used.setdefault(self.linear_solver, None)
         self.test = ScaledTest(self)
         snes.setConvergenceTest(self._test)
         self.snes = snes
@@ -154,6 +164,8 @@ class NewtonSolver:
         assemble_tangent(A, self.J, self.bcs)
         if self.coupling:
             self.coupling.add_to_tangent(A)
+        if self.P is not None:  # the factored copy (its entries replaced, its storage kept)
+            A.convert("dense", self.P)
         self.seconds["assemble_J"] += time.perf_counter() - t
 
     def _test(self, snes, it, norms):
@@ -245,9 +257,37 @@ class NewtonSolver:
         self.test.destroy()
         if self.blocks is not None:
             self.blocks.destroy()
+        if self.P is not None:
+            self.P.destroy()
         self.A.destroy()
         self.b.destroy()
         self.x.destroy()
+
+
+_used = {}  # the linear solvers of the Newton solvers made since the last reset, in order
+
+
+def linear_solvers(reset=False):
+    """The linear solvers (:func:`describe`) of the Newton solvers made in this process since
+    the last call with ``reset`` (a run's start); ``reset``: forget them after reading."""
+    out = list(_used)
+    if reset:
+        _used.clear()
+    return out
+
+
+def describe(ksp, dense=False):
+    """The linear solver a KSP runs, in words: e.g. "LU (mumps)", "dense LU (LAPACK getrf,
+    partial pivoting)", "cg + hypre"."""
+    pc = ksp.getPC()
+    kind = pc.getType()
+    if dense:
+        return "dense LU (LAPACK getrf, partial pivoting)"
+    if kind in ("lu", "cholesky", "ilu", "icc"):
+        solver = pc.getFactorSolverType() or "petsc"
+        words = f"{'LU' if kind == 'lu' else kind} ({solver})"
+        return words if ksp.getType() == "preonly" else f"{ksp.getType()} + {words}"
+    return f"{ksp.getType()} + {kind}"
 
 
 _reasons = {}
