@@ -40,6 +40,7 @@ class RunResult:
     accuracy: dict | None = None  # the [accuracy] refinement, if asked
     pictures: dict | None = None  # the pictures rendered, if asked
     reactions: dict | None = None  # reactions and their balance (static and arc length)
+    linear_solver: tuple = ()  # the linear solvers of the run's Newton solves
 
     @property
     def converged(self) -> bool:
@@ -49,6 +50,8 @@ class RunResult:
     def to_json(self) -> dict:
         """The content of results.json: scene, result, model, probes, wall time and outputs."""
         out = {"scene": self.scene, **self.result.to_json(), "model": self.model}
+        if self.linear_solver:
+            out["linear_solver"] = list(self.linear_solver)
         if self.accuracy is not None:
             out["accuracy"] = self.accuracy
         if self.reactions is not None:
@@ -95,6 +98,7 @@ def run_scene(
     from .io import log as default_log
     from .io.folder import claim
     from .solvers.forms import remember_loaded_modules
+    from .solvers.snes import linear_solvers
 
     remember_loaded_modules()  # before the elements' lookup too: a later run here finds them
     comm, t_start = comm or MPI.COMM_WORLD, time.perf_counter()
@@ -111,11 +115,15 @@ def run_scene(
     out = _prepare(Path(out_dir or scene.output_dir), scene, comm, out_dir is None)
     log(f"beamfx: {path} -> {out}/")
     with claim(out, comm, path, restart, log):  # locked, an earlier run's files removed
+        linear_solvers(reset=True)  # those of this run only
         scene, refinement = _refine(scene, comm, log)
         t_model = time.perf_counter()
         ctx = _context(scene, out, comm, log, restart, png or animate)
         t_model = time.perf_counter() - t_model
         result = _analyse(analysis(scene.analysis), scene, ctx, log)
+        linear = tuple(linear_solvers(reset=True))
+        if linear:
+            log(f"linear solver: {', '.join(linear)}")
         ctx.frames.close()
         ctx.close()
         output = {f"output_{k}": v for k, v in ctx.seconds.items()}
@@ -129,6 +137,7 @@ def run_scene(
             ctx.frames.files(),
             refinement.entry(scene.accuracy) if refinement else None,
             reactions=_reactions(ctx),
+            linear_solver=linear,
         )
         return _finish(run, out, scene, refinement, log, comm, png, animate)
 
