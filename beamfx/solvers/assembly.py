@@ -4,7 +4,7 @@ solvers: Newton, arc length, load scaling)."""
 import numpy as np
 
 
-def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None):
+def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, constants=None):
     """Residual b = F with lifting of ``bcs`` about ``x``, b = x - g on constrained rows (b zeroed).
 
     The Newton correction then drives the constrained dofs to their prescribed values g.
@@ -14,27 +14,42 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None):
     each of its terms is then an exact zero. ``keep``: an array of the owned size that
     receives F before the conditions replace its constrained rows (with the lifting if
     there was one; the return value then says so). ``targets``: the prescribed values on
-    ``rows`` (:func:`prescribed`), if the caller knows them.
+    ``rows`` (:func:`prescribed`), if the caller knows them; ``constants``: F's constants
+    packed (``dolfinx.cpp.fem.pack_constants``), if the caller knows they have not changed.
+
+    DOLFINx's C++ assembler is called directly (its Python wrappers cost more than the
+    kernels of a small model), and one rank has no ghosts to add up.
 
     Returns:
         (local sum of squares of F on ``rows``, whether the lifting was applied).
     """
+    import dolfinx.cpp.fem as cpp
     import dolfinx.fem.petsc as fp
     from petsc4py import PETSc
 
-    lift = lifts(bcs, x, rows, targets)
+    serial = F.mesh.comm.size == 1
+    lift = lifts(bcs, x, rows, targets, serial)
     with b.localForm() as local:
-        local.set(0.0)
-    fp.assemble_vector(b, F)
+        array = local.array_w  # owned and ghost entries; given back (written) on del
+        array.fill(0.0)
+        constants = cpp.pack_constants(F) if constants is None else constants
+        cpp.assemble_vector(array, F, constants, cpp.pack_coefficients(F))
+        del array
     if lift:
         fp.apply_lifting(b, [J], bcs=[bcs], x0=[x], scale=-1.0)
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    if keep is not None:
-        keep[:] = b.getArray(readonly=True)
+    if not serial:
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     local = 0.0
-    if rows is not None and len(rows):
-        local = _sum_of_squares(b.getArray(readonly=True)[rows])
-    fp.set_bc(b, bcs, x, -1.0)
+    if keep is not None or (rows is not None and len(rows)):
+        owned = b.getArray(readonly=True)
+        if keep is not None:
+            keep[:] = owned
+        if rows is not None and len(rows):
+            local = _sum_of_squares(owned[rows])
+        del owned
+    array = b.array_w
+    cpp.set_bc(array, bcs, x.array_r, -1.0)
+    del array
     return local, lift
 
 
@@ -48,24 +63,26 @@ def _sum_of_squares(v):
         return float(np.add.reduce(v * v))
 
 
-def lifts(bcs, x, rows, targets=None):
+def lifts(bcs, x, rows, targets=None, serial=None):
     """Whether the lifting of ``bcs`` about ``x`` can be nonzero: some constrained dof of
     ``x`` differs from its prescribed value g (or is not finite) on some rank. Each term of
     the lifting is A_ij (g_j - x_j), an exact zero where x_j = g_j: a time step or a load
     step that starts from the prescribed values, and every Newton iterate after the first,
     need none. ``rows``: the owned constrained rows (None: always lift); ``targets``: g on
-    them (:func:`prescribed`), if known. Collective."""
+    them (:func:`prescribed`), if known; ``serial``: whether ``x`` lives on one rank, if
+    known. Collective."""
     if not bcs or rows is None:
         return bool(bcs)
     if targets is None:
         targets = prescribed(bcs, rows, x.getLocalSize())
     local = bool((x.getArray(readonly=True)[rows] != targets).any())  # NaN: lift
-    comm = x.getComm()
-    if comm.getSize() == 1:
+    if serial is None:
+        serial = x.getComm().getSize() == 1
+    if serial:
         return local
     from mpi4py import MPI
 
-    return bool(comm.tompi4py().allreduce(local, op=MPI.LOR))
+    return bool(x.getComm().tompi4py().allreduce(local, op=MPI.LOR))
 
 
 def prescribed(bcs, rows, n_owned):
@@ -77,12 +94,20 @@ def prescribed(bcs, rows, n_owned):
     return g[rows]
 
 
-def assemble_tangent(A, J, bcs):
-    """A = J with identity rows and columns on the constrained dofs (A zeroed first)."""
-    import dolfinx.fem.petsc as fp
+def assemble_tangent(A, J, bcs, constants=None):
+    """A = J with identity rows and columns on the constrained dofs (A zeroed first), as
+    ``dolfinx.fem.petsc.assemble_matrix`` assembles it, through the C++ calls directly.
+    ``constants``: J's constants packed, if the caller knows they have not changed."""
+    import dolfinx.cpp.fem as cpp
+    from petsc4py import PETSc
 
     A.zeroEntries()
-    fp.assemble_matrix(A, J, bcs=bcs)
+    constants = cpp.pack_constants(J) if constants is None else constants
+    cpp.petsc.assemble_matrix(A, J, constants, cpp.pack_coefficients(J), bcs)
+    if J.function_spaces[0] is J.function_spaces[1]:  # square: the conditions' diagonal
+        A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
+        A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+        cpp.petsc.insert_diagonal(A, J.function_spaces[0], bcs, 1.0)
     A.assemble()
 
 

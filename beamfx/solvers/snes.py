@@ -122,6 +122,7 @@ class NewtonSolver:
         self._rows = constrained_rows(bcs, self.b.getLocalSize())
         self._kept = None  # (x, F before the conditions, lifted) of the last residual
         self._targets = None  # the prescribed values on the constrained rows, per solve
+        self._constants = (None, None)  # F's and J's constants packed, per solve
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
@@ -142,15 +143,18 @@ class NewtonSolver:
         from petsc4py import PETSc
 
         t = time.perf_counter()
-        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        serial = self.comm.size == 1  # no ghosts to update
+        if not serial:
+            x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         x.copy(self.w.vector)
-        self.w.x.scatter_forward()
+        if not serial:
+            self.w.x.scatter_forward()
         if self.coupling:
             self.coupling.update()
         kept = self._kept
         keep = kept[1] if kept else None
         local, lifted = assemble_residual(
-            b, self.F, self.J, self.bcs, x, self._rows, keep, self._targets
+            b, self.F, self.J, self.bcs, x, self._rows, keep, self._targets, self._constants[0]
         )
         if kept:
             kept[0][:] = x.getArray(readonly=True)
@@ -161,7 +165,7 @@ class NewtonSolver:
 
     def _jacobian(self, snes, x, A, P):
         t = time.perf_counter()
-        assemble_tangent(A, self.J, self.bcs)
+        assemble_tangent(A, self.J, self.bcs, self._constants[1])
         if self.coupling:
             self.coupling.add_to_tangent(A)
         if self.P is not None:  # the factored copy (its entries replaced, its storage kept)
@@ -215,6 +219,9 @@ class NewtonSolver:
         self.test.reset()
         # the prescribed values, fixed during the solve (whether a residual needs a lifting)
         self._targets = prescribed(self.bcs, self._rows, self.b.getLocalSize())
+        # the forms' constants (load factor, time, step) are those of this solve; a coupling
+        # may change them at each residual: packed at every assembly then
+        self._constants = (None, None) if self.coupling else packed_constants(self.F, self.J)
         before = dict(self.seconds)
         linear_before = linear_solve_seconds()
         t = time.perf_counter()
@@ -298,6 +305,13 @@ def _reason_name(code):
     if not _reasons:
         _reasons.update(reason_names())
     return _reasons.get(code, str(code))
+
+
+def packed_constants(*forms):
+    """The constants of each form as DOLFINx's assemblers take them, packed."""
+    from dolfinx.cpp.fem import pack_constants
+
+    return tuple(pack_constants(form) for form in forms)
 
 
 def constrained_rows(bcs, n_owned):
