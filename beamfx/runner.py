@@ -98,7 +98,7 @@ def run_scene(
     from .io import log as default_log
     from .io.folder import claim
     from .solvers.forms import remember_loaded_modules
-    from .solvers.snes import linear_solvers
+    from .solvers.options import linear_solvers
 
     remember_loaded_modules()  # before the elements' lookup too: a later run here finds them
     comm, t_start = comm or MPI.COMM_WORLD, time.perf_counter()

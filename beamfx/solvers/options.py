@@ -88,8 +88,9 @@ def expand_linear(options):
 DENSE_LIMIT = 100
 #: the options of the dense LU (on the converted matrix: :func:`use_dense`)
 DENSE = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "petsc"}
-#: the options by which a user picks the linear solver: any of them given, the dense LU is not
-LINEAR_KEYS = ("ksp_type", "pc_type", "pc_factor_mat_solver_type")
+#: the options (and prefixes of options) by which a user picks or tunes the linear solver: any
+#: of them given (e.g. a MUMPS control, a factorisation's ordering or shift), the dense LU is not
+LINEAR_KEYS = ("ksp_type", "pc_type", "pc_factor_", "mat_mumps_")
 
 
 def use_dense(options, size, ranks, preset=()):
@@ -103,7 +104,37 @@ def use_dense(options, size, ranks, preset=()):
     options = options or {}
     if options.get("linear", "direct") != "direct":
         return False
-    return not any(key in options or key in preset for key in LINEAR_KEYS)
+    return not any(name.startswith(LINEAR_KEYS) for name in (*options, *preset))
+
+
+_used = {}  # the linear solvers of the Newton solvers made since the last reset, in order
+
+
+def linear_solvers(reset=False):
+    """The linear solvers (:func:`describe`) of the Newton solvers made in this process since
+    the last call with ``reset`` (a run's start); ``reset``: forget them after reading."""
+    out = list(_used)
+    if reset:
+        _used.clear()
+    return out
+
+
+def describe(ksp, dense=False):
+    """The linear solver a KSP runs, in words: e.g. "LU (mumps)", "dense LU (LAPACK getrf,
+    partial pivoting)", "cg + hypre"; recorded for :func:`linear_solvers`. ``dense``: its
+    operator is the dense copy of :func:`use_dense`."""
+    pc = ksp.getPC()
+    kind = pc.getType()
+    if dense:
+        words = "dense LU (LAPACK getrf, partial pivoting)"
+    elif kind in ("lu", "cholesky", "ilu", "icc"):
+        solver = pc.getFactorSolverType() or "petsc"
+        words = f"{'LU' if kind == 'lu' else kind} ({solver})"
+        words = words if ksp.getType() == "preonly" else f"{ksp.getType()} + {words}"
+    else:
+        words = f"{ksp.getType()} + {kind}"
+    _used.setdefault(words, None)
+    return words
 
 
 def is_iterative(options):

@@ -9,7 +9,7 @@ from .assembly import assemble_residual, assemble_tangent, prescribed
 from .blocked import use_node_blocks
 from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
-from .options import DENSE, LINEAR_KEYS, expand_linear, petsc_options, use_dense
+from .options import DENSE, describe, expand_linear, petsc_options, use_dense
 
 #: defaults chosen for beams (notes §4): full Newton steps (the bt line search stalls on the
 #: stiff axial term), no divergence stop, LU with MUMPS. The convergence test is beamfx's
@@ -110,7 +110,7 @@ class NewtonSolver:
         self._residuals = []
         self.options = {**DEFAULT_OPTIONS, **expand_linear(options)}
         # a small serial tangent: factored dense (LAPACK) from a copy kept beside the sparse A
-        given = [k for k in LINEAR_KEYS if PETSc.Options().hasName(f"{prefix}{k}")]
+        given = [k.removeprefix(prefix) for k in PETSc.Options().getAll() if k.startswith(prefix)]
         self.P = None
         if use_dense(options, self.A.getSize()[0], self.comm.size, given):
             self.options.update(DENSE)
@@ -133,8 +133,7 @@ class NewtonSolver:
             snes.setFromOptions()
             snes.getKSP().setFromOptions()
             self.blocks = use_node_blocks(snes.getKSP(), w)  # AMG on whole beam nodes
-        self.linear_solver = describe(snes.getKSP(), self.P is not None)
-        _used.setdefault(self.linear_solver, None)
+        self.linear_solver = describe(snes.getKSP(), self.P is not None)  # recorded
         self.test = ScaledTest(self)
         snes.setConvergenceTest(self._test)
         self.snes = snes
@@ -269,32 +268,6 @@ class NewtonSolver:
         self.A.destroy()
         self.b.destroy()
         self.x.destroy()
-
-
-_used = {}  # the linear solvers of the Newton solvers made since the last reset, in order
-
-
-def linear_solvers(reset=False):
-    """The linear solvers (:func:`describe`) of the Newton solvers made in this process since
-    the last call with ``reset`` (a run's start); ``reset``: forget them after reading."""
-    out = list(_used)
-    if reset:
-        _used.clear()
-    return out
-
-
-def describe(ksp, dense=False):
-    """The linear solver a KSP runs, in words: e.g. "LU (mumps)", "dense LU (LAPACK getrf,
-    partial pivoting)", "cg + hypre"."""
-    pc = ksp.getPC()
-    kind = pc.getType()
-    if dense:
-        return "dense LU (LAPACK getrf, partial pivoting)"
-    if kind in ("lu", "cholesky", "ilu", "icc"):
-        solver = pc.getFactorSolverType() or "petsc"
-        words = f"{'LU' if kind == 'lu' else kind} ({solver})"
-        return words if ksp.getType() == "preonly" else f"{ksp.getType()} + {words}"
-    return f"{ksp.getType()} + {kind}"
 
 
 _reasons = {}

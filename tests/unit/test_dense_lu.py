@@ -25,7 +25,14 @@ def test_dense_only_where_no_linear_solver_is_given():
     assert use_dense({"linear": "direct", "snes_rtol": 1e-9}, 27, 1)  # direct: dense is one
     assert not use_dense({}, DENSE_LIMIT + 1, 1)  # MUMPS's sparsity wins beyond
     assert not use_dense({}, 27, 2)  # several ranks: MUMPS
-    for given in (MUMPS, {"pc_type": "cholesky"}, {"ksp_type": "gmres"}, {"linear": "iterative"}):
+    for given in (
+        MUMPS,
+        {"pc_type": "cholesky"},
+        {"ksp_type": "gmres"},
+        {"linear": "iterative"},
+        {"mat_mumps_icntl_14": 50},  # a MUMPS control: MUMPS
+        {"pc_factor_shift_type": "nonzero"},  # a sparse factorisation's tuning
+    ):
         assert not use_dense(given, 27, 1), given
     assert not use_dense({}, 27, 1, preset=["pc_factor_mat_solver_type"])  # PETSc's database
 
