@@ -113,7 +113,9 @@ def iteration_line(c):
     passing setting ``c``, and the stack's limit at that size where measured."""
     t = c["warm_per_iteration_s"]
     line = (
-        f"Per Newton iteration at {c['elements']} x P{c['degree']} (warm, ms): "
+        f"Per Newton iteration at {c['elements']} x P{c['degree']} (warm, ms"
+        + (f"; {', '.join(c['linear_solver'])}" if c.get("linear_solver") else "")
+        + "): "
         f"assemble residual {1e3 * t['assemble_F']:.2f}, tangent "
         f"{1e3 * t['assemble_J']:.2f}, LU factorisation {1e3 * t['factorise']:.2f}, "
         f"triangular solves {1e3 * t['triangular_solve']:.2f}, Python and the rest "

@@ -53,6 +53,7 @@ def run_setting(case, elements, degree):
         "wall_s_warm": newton_seconds(result.seconds),
         "jit_s": jit,
         "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
+        "linear_solver": warm_run.get("linear_solver"),
         **jit_seconds(case.id, model),
         **stack_limits(model),
         "values": {k: float(v) for k, v in case.measure(run.probes).items()},

@@ -152,6 +152,7 @@ class TransientCase(Case):
             "wall_s_warm": newton_seconds(result.seconds),
             "jit_s": jit,
             "warm_per_iteration_s": per_iteration(result.seconds, result.newton_iterations),
+            "linear_solver": warm_run.get("linear_solver"),
             **stack_limits(BeamModel(scene.model), self.build(elements, degree, dt, *scheme)[1]),
             "values": {k: float(v) for k, v in self.measure(history, scene.model).items()},
             "history": _thinned((self.series or tip_series)(history)),

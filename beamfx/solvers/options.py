@@ -80,11 +80,11 @@ def expand_linear(options):
 
 
 #: the largest serial system Newton factors by a dense LU (PETSc's seqdense LU: LAPACK getrf,
-#: partial pivoting, so a saddle point's zero diagonal is no obstacle) instead of MUMPS. On
-#: beamfx tangents (planar, 3D, mixed; 9 to 438 unknowns) MUMPS costs 0.1-0.2 ms per
-#: factorisation and solve below 100 unknowns, its set-up and analysis more than the work;
-#: the dense LU costs 3 µs at 9, 7 at 27, 30 at 60 and 100 µs at 100 unknowns, and grows as
-#: n³: the two cross between 110 and 130 unknowns (2 cores shared, noisy; issue 20)
+#: partial pivoting, so a saddle point's zero diagonal is no obstacle) instead of MUMPS.
+#: Factorisation and solve on beamfx tangents (planar, condensed, 3D, mixed), CPU time: MUMPS
+#: 110-160 µs below 100 unknowns (its set-up, not the work), the dense LU 7 µs at 27, 33 at
+#: 51-60, 50-75 at 75-87 and 100 µs at 99, growing as n³; they cross at 110-125 unknowns
+#: (ratio 1.1-1.4 at 111-114, 0.9 at 123) and 100 keeps a margin of 1.5 (issue 20)
 DENSE_LIMIT = 100
 #: the options of the dense LU (on the converted matrix: :func:`use_dense`)
 DENSE = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "petsc"}
