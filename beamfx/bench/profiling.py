@@ -29,10 +29,11 @@ def newton_seconds(seconds):
 
 def per_iteration(seconds, iterations):
     """Seconds per Newton iteration of a solve: assembly, LU, triangular solves, the rest
-    (Python), from the solve's wall-time split ``seconds``."""
+    (Python), and beamfx's convergence test (``test``, not in ``python``), from the solve's
+    wall-time split ``seconds``."""
     its = max(iterations, 1)
-    keys = ("assemble_F", "assemble_J", "factorise", "triangular_solve", "python")
-    return {k: seconds[k] / its for k in keys}
+    keys = ("assemble_F", "assemble_J", "factorise", "triangular_solve", "python", "test")
+    return {k: seconds.get(k, 0.0) / its for k in keys}
 
 
 def jit_seconds(case_id, model):
@@ -119,7 +120,8 @@ def iteration_line(c):
         f"assemble residual {1e3 * t['assemble_F']:.2f}, tangent "
         f"{1e3 * t['assemble_J']:.2f}, LU factorisation {1e3 * t['factorise']:.2f}, "
         f"triangular solves {1e3 * t['triangular_solve']:.2f}, Python and the rest "
-        f"{1e3 * t['python']:.2f}."
+        f"{1e3 * t['python']:.2f}"
+        + (f", convergence test {1e3 * t['test']:.2f}." if "test" in t else ".")
     )
     if "limit_assembly_s" in c:
         assembly, lu = limit_ms(c)
