@@ -29,12 +29,12 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, const
 
     serial = F.mesh.comm.size == 1
     lift = lifts(bcs, x, rows, targets, serial)
-    with b.localForm() as local:
-        array = local.array_w  # owned and ghost entries; given back (written) on del
-        array.fill(0.0)
-        constants = cpp.pack_constants(F) if constants is None else constants
-        cpp.assemble_vector(array, F, constants, cpp.pack_coefficients(F))
-        del array
+    constants = cpp.pack_constants(F) if constants is None else constants
+    if serial:  # no ghost entries: the owned array is the local form's
+        _assemble_into(b.array_w, F, constants)
+    else:
+        with b.localForm() as local:
+            _assemble_into(local.array_w, F, constants)
     if lift:
         fp.apply_lifting(b, [J], bcs=[bcs], x0=[x], scale=-1.0)
     if not serial:
@@ -53,6 +53,15 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, const
     return local, lift
 
 
+def _assemble_into(array, F, constants):
+    """``array`` = F assembled (zeroed first); the array is given back to PETSc (its state
+    raised, as written) when the caller's reference goes."""
+    import dolfinx.cpp.fem as cpp
+
+    array.fill(0.0)
+    cpp.assemble_vector(array, F, constants, cpp.pack_coefficients(F))
+
+
 def _sum_of_squares(v):
     """Σ v², as ``np.sum(v ** 2)`` sums it; a diverging iterate's overflow to inf is quiet
     (the test then says NaN or diverged). ``np.errstate`` only where it can overflow: it
@@ -69,13 +78,17 @@ def lifts(bcs, x, rows, targets=None, serial=None):
     the lifting is A_ij (g_j - x_j), an exact zero where x_j = g_j: a time step or a load
     step that starts from the prescribed values, and every Newton iterate after the first,
     need none. ``rows``: the owned constrained rows (None: always lift); ``targets``: g on
-    them (:func:`prescribed`), if known; ``serial``: whether ``x`` lives on one rank, if
+    them (:func:`prescribed`, or its ``tolist()``), if known; ``serial``: whether ``x`` lives on one rank, if
     known. Collective."""
     if not bcs or rows is None:
         return bool(bcs)
     if targets is None:
         targets = prescribed(bcs, rows, x.getLocalSize())
-    local = bool((x.getArray(readonly=True)[rows] != targets).any())  # NaN: lift
+    values = x.getArray(readonly=True)[rows]
+    if isinstance(targets, list):  # as floats: compared without NumPy's dispatch
+        local = values.tolist() != targets  # NaN: never equal, lift
+    else:
+        local = bool((values != targets).any())  # NaN: lift
     if serial is None:
         serial = x.getComm().getSize() == 1
     if serial:

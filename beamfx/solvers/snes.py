@@ -1,5 +1,6 @@
 """Newton's method through PETSc SNES on a residual form and its Jacobian."""
 
+import math
 import time
 from typing import NamedTuple
 
@@ -159,7 +160,7 @@ class NewtonSolver:
             kept[0][:] = x.getArray(readonly=True)
             kept[2] = lifted
         comm = self.comm
-        self.reactions = float(np.sqrt(comm.allreduce(local) if comm.size > 1 else local))
+        self.reactions = math.sqrt(comm.allreduce(local) if comm.size > 1 else local)
         self.seconds["assemble_F"] += time.perf_counter() - t
 
     def _jacobian(self, snes, x, A, P):
@@ -217,7 +218,7 @@ class NewtonSolver:
         self._residuals = []
         self.test.reset()
         # the prescribed values, fixed during the solve (whether a residual needs a lifting)
-        self._targets = prescribed(self.bcs, self._rows, self.b.getLocalSize())
+        self._targets = prescribed(self.bcs, self._rows, self.b.getLocalSize()).tolist()
         # the forms' constants (load factor, time, step) are those of this solve; a coupling
         # may change them at each residual: packed at every assembly then
         self._constants = (None, None) if self.coupling else packed_constants(self.F, self.J)
