@@ -106,8 +106,11 @@ def test_generalized_alpha_decays_as_its_spectral_radius(rho_inf, omega_h):
     solve_transient(model, settings, on_step=lambda r: energy.append(sum(
         r.energy[k] for k in ("kinetic", "strain"))))  # fmt: skip
     energy = np.array(energy[1:])
+    # the steps before the energy first falls below 1e-10 of the start: beyond, it is the
+    # round-off floor's noise, which may cross that line again at any later step
     above = energy > 1e-10 * energy[0]
-    assert above.sum() > 50
-    slope = np.polyfit(np.arange(len(energy))[above], np.log(energy[above]), 1)[0]
+    decaying = int(np.argmin(above)) if not above.all() else len(energy)
+    assert decaying > 50
+    slope = np.polyfit(np.arange(decaying), np.log(energy[:decaying]), 1)[0]
     predicted = np.log(spectral_radius(rho_inf, omega_h))
     assert slope / 2 == pytest.approx(predicted, rel=0.01)
