@@ -167,13 +167,14 @@ class Solid:
         history = step_load(solve_at, State(), steps=n, easy_iterations=6, log=log)
         self.seconds["solve"] = time.perf_counter() - t1
         nonzeros = int(solver.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_used"])
+        direct = "mumps" if solver.P is None else "dense LU"  # a tiny serial model: dense
         solver.destroy()
         return {
             "matrix_nonzeros": nonzeros,
             "load_steps": len(history),
             "newton_iterations": int(sum(h.iterations for h in history)),
             "krylov_iterations": int(sum(ksp_its)),
-            "linear_solver": "cg+gamg" if self.iterative() else "mumps",
+            "linear_solver": "cg+gamg" if self.iterative() else direct,
         }
 
     def modes(self, targets, per_target=4):
