@@ -352,7 +352,9 @@ class CondensedModel(Discretised):
         m = self.mesh.mesh
         cache = self._integrator = self._integrator or {}
         if subintervals not in cache:
-            gx, gw = np.polynomial.legendre.leggauss(self.degree + 2)
+            if "gauss" not in cache:  # the rule of every count (an eigenvalue solve: once)
+                cache["gauss"] = np.polynomial.legendre.leggauss(self.degree + 2)
+            gx, gw = cache["gauss"]
             local = (np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals
             points = (xi[:, None] * local.ravel()[None, :]).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| (t0·t_s) u'
