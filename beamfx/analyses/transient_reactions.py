@@ -34,12 +34,12 @@ goes (rank 0; the writer a static run uses too, :mod:`beamfx.io.reaction_files`)
 and the largest values over the run.
 """
 
-import math
 from typing import NamedTuple
 
 import numpy as np
 
 from ..io.reaction_files import ReactionCsv, columns
+from ..physics.rotations import _norm  # np.linalg.norm's value, without its checks
 from .dofs import constrained_dofs, owned_size
 from .reactions import ReactionRecovery
 
@@ -113,12 +113,6 @@ class TransientReactions:
             free_residual,
         )
         return reactions, balance
-
-
-def _norm(v):
-    """``np.linalg.norm`` of a vector, as it computes it (the square root of ``v.dot(v)``),
-    without its checks: a float."""
-    return math.sqrt(v.dot(v))
 
 
 def _row(step, time, reactions, balance):
