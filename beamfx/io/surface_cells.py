@@ -105,8 +105,8 @@ def surface_cells(cell, beam, beam_names, outlines, subdivisions=4, ends=None):
         n_points += len(elements) * samples * ring
     if not parts:
         none = np.zeros(0, np.int64)
-        out = SurfaceCells(none, np.zeros(1, np.int64), none.astype(np.uint8), {}, ())
-        out.cell_data.update(cell=none, beam=none)
+        cell_data = {"cell": none, "beam": none}
+        out = SurfaceCells(none, np.zeros(1, np.int64), none.astype(np.uint8), cell_data, ())
     else:  # each list joined and emptied in turn: its pieces and the whole are not all held at once
         element = join(element).astype(np.int64, copy=False)
         sizes = join(sizes)
