@@ -53,13 +53,10 @@ def _element_ends(cell, s_beam, ends):
     """Booleans (first, last) per element: does it start or end its beam?"""
     n_el = len(s_beam)
     if ends is None:  # the first and last element of each beam among these fields
-        first, last = {}, {}
-        for e, b in enumerate(s_beam.tolist()):
-            first.setdefault(b, e)
-            last[b] = e
-        return np.isin(np.arange(n_el), list(first.values())), np.isin(
-            np.arange(n_el), list(last.values())
-        )
+        first, last = np.zeros(n_el, bool), np.zeros(n_el, bool)
+        first[np.unique(s_beam, return_index=True)[1]] = True  # first occurrences
+        last[n_el - 1 - np.unique(s_beam[::-1], return_index=True)[1]] = True
+        return first, last
     lo, hi = (np.asarray(a) for a in ends)
     return cell == lo[s_beam], cell == hi[s_beam]
 
