@@ -21,7 +21,7 @@ x' = R(t0 + Λ0 Γ) cell by cell (:meth:`sync`, exact to quadrature); the sectio
 statically determined one, in section axes Λ0ᵀRᵀn.
 """
 
-from functools import cached_property
+from functools import cache, cached_property
 
 import numpy as np
 import ufl
@@ -42,6 +42,12 @@ MAX_ANGLE = np.radians(330.0)
 #: round basis values within 1e-6 of 0 or ±1 to those numbers, which costs 1e-8 of the
 #: displacement at Gauss points near a cell's end (measured: P4, 8 parts per cell)
 EXACT_TABLES = {"table_rtol": 1e-15, "table_atol": 1e-15}
+
+
+@cache
+def _gauss(points):
+    """Gauss-Legendre points and weights on [-1, 1] (an eigenvalue solve: once per count)."""
+    return np.polynomial.legendre.leggauss(points)
 
 
 class RotationRangeError(ValueError):
@@ -352,9 +358,7 @@ class CondensedModel(Discretised):
         m = self.mesh.mesh
         cache = self._integrator = self._integrator or {}
         if subintervals not in cache:
-            if "gauss" not in cache:  # the rule of every count (an eigenvalue solve: once)
-                cache["gauss"] = np.polynomial.legendre.leggauss(self.degree + 2)
-            gx, gw = cache["gauss"]
+            gx, gw = _gauss(self.degree + 2)
             local = (np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals
             points = (xi[:, None] * local.ravel()[None, :]).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| (t0·t_s) u'
