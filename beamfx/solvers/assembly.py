@@ -148,16 +148,16 @@ def assembler(F, J, bcs):
     """(residual vector, tangent matrix, ``assemble()`` filling both) of the UFL forms F and J
     with the supports ``bcs`` applied to the tangent: the assembly of one Newton iteration."""
     import dolfinx.fem.petsc as fp
+    from dolfinx.cpp.fem import pack_constants
 
     from .forms import compile_form
 
     F, J = compile_form(F), compile_form(J)
     b, A = fp.create_vector(F), fp.create_matrix(J)
 
-    def assemble():
+    def assemble():  # as Newton's callbacks assemble (:func:`assemble_residual`)
         with b.localForm() as local:
-            local.set(0.0)
-        fp.assemble_vector(b, F)
+            _assemble_into(local.array_w, F, pack_constants(F))
         assemble_tangent(A, J, bcs)
 
     return b, A, assemble
