@@ -38,7 +38,11 @@ def remember_loaded_modules():
     ``importlib.machinery.FileFinder`` lists the whole cache folder: about 2.5 ms per form with
     5000 files in ``~/.cache/fenics``, half of a small run's time), although the module is
     loaded already. The module name is the hash of the form and its parameters, and a loaded
-    extension module cannot change, so the second lookup is answered from memory. Idempotent.
+    extension module cannot change, so the second lookup is answered from memory. The first
+    lookup of a module compiled and marked ready (``<name>.c.cached``) loads its extension file
+    by name (:func:`_load_ready`) without listing the folder (6 ms a module with 11 000 files,
+    the listing growing with every model a user has run); anything else (not compiled, being
+    compiled by another process, another file name) goes through FFCx's lookup. Idempotent.
     """
     from ffcx.codegeneration import jit
 
@@ -52,7 +56,9 @@ def remember_loaded_modules():
     def get_cached_module(module_name, object_names, cache_dir, timeout):
         key = (module_name, str(cache_dir), tuple(object_names))
         if key not in loaded:
-            found = lookup(module_name, object_names, cache_dir, timeout)
+            found = _load_ready(module_name, object_names, cache_dir)
+            if found is None:
+                found = lookup(module_name, object_names, cache_dir, timeout)
             if found[0] is None:  # not compiled yet: this caller compiles it
                 return found
             loaded[key] = found
@@ -61,6 +67,26 @@ def remember_loaded_modules():
     get_cached_module.beamfx_memo = True
     get_cached_module.loaded = loaded
     jit.get_cached_module = get_cached_module
+
+
+def _load_ready(module_name, object_names, cache_dir):
+    """(compiled objects, module) of the JIT module ``module_name`` if FFCx marked it ready in
+    ``cache_dir`` and its extension file has the interpreter's own suffix (what FFCx's
+    ``FileFinder`` finds first), loaded as FFCx loads it; else None."""
+    import importlib.machinery
+    import importlib.util
+    from pathlib import Path
+
+    folder = Path(cache_dir)
+    suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
+    path = folder / f"{module_name}{suffix}"
+    if not (folder / f"{module_name}.c.cached").exists() or not path.exists():
+        return None
+    loader = importlib.machinery.ExtensionFileLoader(module_name, str(path))
+    spec = importlib.util.spec_from_file_location(module_name, str(path), loader=loader)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return [getattr(module.lib, name) for name in object_names], module
 
 
 def _expression_signature_once():

@@ -257,3 +257,30 @@ def test_compile_flags_get_a_cache_of_their_own():
     assert _compile_flags({"BEAMFX_JIT_CFLAGS": "  "}) == {}
     got = _compile_flags({"BEAMFX_JIT_CFLAGS": "-O0 -g0", "XDG_CACHE_HOME": "/c"})
     assert got == {"cffi_extra_compile_args": ["-O0", "-g0"], "cache_dir": "/c/fenics-O0_g0"}
+
+
+def test_a_ready_jit_module_is_loaded_by_name_as_ffcx_finds_it(tmp_path):
+    """The first lookup of a compiled module loads its extension file by name
+    (forms._load_ready, no listing of the cache folder): the module FFCx's own lookup finds,
+    with the same objects; a module not compiled or not marked ready is left to FFCx."""
+    import dolfinx
+    import ufl
+    from ffcx.codegeneration import jit
+    from mpi4py import MPI
+
+    from beamfx.solvers.forms import _load_ready, compile_form
+
+    mesh = dolfinx.mesh.create_unit_interval(MPI.COMM_WORLD, 2)
+    V = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 2))
+    u = dolfinx.fem.Function(V)
+    compile_form(u * u * u * ufl.dx(metadata={"quadrature_degree": 6}))
+    memo = jit.get_cached_module.loaded
+    (name, folder, objects) = next(k for k in memo if k[0].startswith("libffcx_forms_"))
+    found = _load_ready(name, list(objects), folder)
+    assert found is not None
+    ffcx_objects, ffcx_module = memo[(name, folder, objects)]
+    assert found[1].__file__ == ffcx_module.__file__
+    assert [str(o) for o in found[0]] == [str(o) for o in ffcx_objects]
+    assert _load_ready("libffcx_forms_not_there", list(objects), folder) is None
+    (tmp_path / f"{name}.c").write_text("")  # being compiled elsewhere: not ready
+    assert _load_ready(name, list(objects), tmp_path) is None
