@@ -145,6 +145,9 @@ def main(argv=None):
     """``beamfx <command>``: 0 on success, 2 on bad input, 3 on a failed solve, 130/143 when
     interrupted by SIGINT/SIGTERM. Under MPI a failure on any rank ends every rank
     (:func:`beamfx.interrupt.stop_everywhere`): never a hang."""
+    from .startup import prepare
+
+    prepare()  # before mpi4py and UFL are imported (beamfx.startup)
     from .interrupt import error_comm, handle_signals, stop_everywhere
 
     args = _parser().parse_args(argv)

@@ -76,4 +76,9 @@ else
   touch "$stamp"
   log "pip: done (numpy $have)"
 fi
+# --- 4. bytecode -----------------------------------------------------------
+# beamfx's modules compiled once (only what changed since): a process never writes them where
+# PYTHONDONTWRITEBYTECODE is set (or the checkout is read-only), and then compiles all of
+# them at every start (0.1 s of a `beamfx run`)
+"$VENV/bin/python" -m compileall -q beamfx >/dev/null
 log "ready: $VENV/bin/beamfx"

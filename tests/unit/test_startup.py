@@ -1,0 +1,39 @@
+"""beamfx.startup: what the command does before the stack's imports."""
+
+import sys
+
+from beamfx import startup
+
+
+def test_a_singleton_asks_for_ob1_and_mpirun_or_the_user_keep_theirs():
+    env = {}
+    assert startup.mpi_singleton(env) and env == {"OMPI_MCA_pml": "ob1"}
+    for launched in ({"OMPI_COMM_WORLD_SIZE": "2"}, {"PMIX_RANK": "0"}, {"OMPI_MCA_pml": "ucx"}):
+        env = dict(launched)
+        assert not startup.mpi_singleton(env) and env == launched
+
+
+def test_ufl_and_ffcx_versions_are_read_as_pkg_resources_reads_them(monkeypatch):
+    """The stand-in answers UFL's and FFCx's own version as the real module does; any other
+    question loads the real module, which then takes its place."""
+    import importlib.metadata
+
+    for name, package in startup.OWN_VERSION.items():
+        assert startup.dist_info_version(name, package) == importlib.metadata.version(name)
+    monkeypatch.delitem(sys.modules, "pkg_resources", raising=False)
+    assert startup.light_versions()
+    stand_in = sys.modules["pkg_resources"]
+    assert isinstance(stand_in, startup._VersionsOnly)
+    assert not startup.light_versions()  # in place already: left alone
+    version = stand_in.get_distribution("fenics-ufl").version
+    assert version == importlib.metadata.version("fenics-ufl")
+    assert "pkg_resources" in sys.modules and sys.modules["pkg_resources"] is stand_in
+    numpy = stand_in.get_distribution("numpy")  # not one of the two: the real answer
+    assert numpy.version == importlib.metadata.version("numpy") and hasattr(numpy, "location")
+    real = sys.modules["pkg_resources"]
+    assert real is not stand_in and stand_in.working_set is real.working_set
+
+
+def test_a_distribution_without_metadata_has_no_version_here():
+    assert startup.dist_info_version("no-such-dist", "beamfx") is None
+    assert startup.dist_info_version("no-such-dist", "no_such_package_here") is None
