@@ -79,6 +79,11 @@ def wrap(owner, name, key):
             T[key] = T.get(key, 0.0) + time.perf_counter() - s
     setattr(owner, name, timed)
 
+try:  # what `beamfx run` does first (revisions before it had no beamfx.startup)
+    from beamfx.startup import prepare
+    prepare()
+except ImportError:
+    pass
 import beamfx.io as io
 import beamfx.solvers.snes as snes
 try:

@@ -55,11 +55,16 @@ class Case:
 
 
 REGISTRY: dict[str, Case] = {}
+#: case id -> the module that registered it (a process of one setting imports only that one)
+REGISTERED_IN: dict[str, str] = {}
 
 
 def register(case):
     """Add ``case`` to :data:`REGISTRY` (its id must be new); return it."""
+    import sys
+
     if case.id in REGISTRY:
         raise ValueError(f"duplicate benchmark case {case.id}")
     REGISTRY[case.id] = case
+    REGISTERED_IN[case.id] = sys._getframe(1).f_globals["__name__"]
     return case

@@ -37,3 +37,16 @@ def test_ufl_and_ffcx_versions_are_read_as_pkg_resources_reads_them(monkeypatch)
 def test_a_distribution_without_metadata_has_no_version_here():
     assert startup.dist_info_version("no-such-dist", "beamfx") is None
     assert startup.dist_info_version("no-such-dist", "no_such_package_here") is None
+
+
+def test_a_bench_process_imports_only_the_module_of_its_case():
+    """``beamfx.bench.process`` runs one setting after importing the module that registered
+    its case, not every paper's (some compute their theory at import)."""
+    from beamfx.bench import all_cases
+    from beamfx.bench.registry import REGISTERED_IN
+
+    cases = all_cases()
+    assert REGISTERED_IN["rollup_0.5"] == "beamfx.bench.classic"
+    assert REGISTERED_IN["spin_up_time"] == "beamfx.bench.transient"
+    assert set(REGISTERED_IN) == set(cases)
+    assert all(m.startswith("beamfx.bench.") and m in sys.modules for m in REGISTERED_IN.values())
