@@ -42,7 +42,7 @@ PROBLEMS = {
     "spin_up": (
         "spin_up_time",
         tuple((4, 2, dt) for dt in SPIN_DT[:-1])
-        + ((2, 2, SPIN_DT[0], X), (4, 2, SPIN_DT[0], X), (8, 2, SPIN_DT[0], X))
+        + tuple((n, 2, dt, X) for dt in (2 * SPIN_DT[0], SPIN_DT[0]) for n in (2, 4, 8))
         + ((8, 3, SPIN_DT[2], X),),
         "spin-up manoeuvre (VM258), extremes over 0–18 s in the hub frame",
     ),
