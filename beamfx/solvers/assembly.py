@@ -4,7 +4,9 @@ solvers: Newton, arc length, load scaling)."""
 import numpy as np
 
 
-def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, constants=None):
+def assemble_residual(
+    b, F, J, bcs, x, rows=None, keep=None, targets=None, constants=None, coefficients=None
+):
     """Residual b = F with lifting of ``bcs`` about ``x``, b = x - g on constrained rows (b zeroed).
 
     The Newton correction then drives the constrained dofs to their prescribed values g.
@@ -15,7 +17,9 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, const
     receives F before the conditions replace its constrained rows (with the lifting if
     there was one; the return value then says so). ``targets``: the prescribed values on
     ``rows`` (:func:`prescribed`), if the caller knows them; ``constants``: F's constants
-    packed (``dolfinx.cpp.fem.pack_constants``), if the caller knows they have not changed.
+    packed (``dolfinx.cpp.fem.pack_constants``), if the caller knows they have not changed;
+    ``coefficients``: F's coefficients packed (``dolfinx.cpp.fem.pack_coefficients``) at
+    this state, if the caller has them.
 
     DOLFINx's C++ assembler is called directly (its Python wrappers cost more than the
     kernels of a small model), and one rank has no ghosts to add up.
@@ -31,10 +35,10 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, const
     lift = lifts(bcs, x, rows, targets, serial)
     constants = cpp.pack_constants(F) if constants is None else constants
     if serial:  # no ghost entries: the owned array is the local form's
-        _assemble_into(b.array_w, F, constants)
+        _assemble_into(b.array_w, F, constants, coefficients)
     else:
         with b.localForm() as local:
-            _assemble_into(local.array_w, F, constants)
+            _assemble_into(local.array_w, F, constants, coefficients)
     if lift:
         fp.apply_lifting(b, [J], bcs=[bcs], x0=[x], scale=-1.0)
     if not serial:
@@ -53,13 +57,16 @@ def assemble_residual(b, F, J, bcs, x, rows=None, keep=None, targets=None, const
     return local, lift
 
 
-def _assemble_into(array, F, constants):
+def _assemble_into(array, F, constants, coefficients=None):
     """``array`` = F assembled (zeroed first); the array is given back to PETSc (its state
-    raised, as written) when the caller's reference goes."""
+    raised, as written) when the caller's reference goes. ``coefficients``: F's packed, if
+    known."""
     import dolfinx.cpp.fem as cpp
 
     array.fill(0.0)
-    cpp.assemble_vector(array, F, constants, cpp.pack_coefficients(F))
+    if coefficients is None:
+        coefficients = cpp.pack_coefficients(F)
+    cpp.assemble_vector(array, F, constants, coefficients)
 
 
 def _sum_of_squares(v):
@@ -107,16 +114,19 @@ def prescribed(bcs, rows, n_owned):
     return g[rows]
 
 
-def assemble_tangent(A, J, bcs, constants=None):
+def assemble_tangent(A, J, bcs, constants=None, coefficients=None):
     """A = J with identity rows and columns on the constrained dofs (A zeroed first), as
     ``dolfinx.fem.petsc.assemble_matrix`` assembles it, through the C++ calls directly.
-    ``constants``: J's constants packed, if the caller knows they have not changed."""
+    ``constants``: J's constants packed, if the caller knows they have not changed;
+    ``coefficients``: J's coefficients packed at this state, if the caller has them."""
     import dolfinx.cpp.fem as cpp
     from petsc4py import PETSc
 
     A.zeroEntries()
     constants = cpp.pack_constants(J) if constants is None else constants
-    cpp.petsc.assemble_matrix(A, J, constants, cpp.pack_coefficients(J), bcs)
+    if coefficients is None:
+        coefficients = cpp.pack_coefficients(J)
+    cpp.petsc.assemble_matrix(A, J, constants, coefficients, bcs)
     if J.function_spaces[0] is J.function_spaces[1]:  # square: the conditions' diagonal
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
         A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
@@ -161,3 +171,17 @@ def assembler(F, J, bcs):
         assemble_tangent(A, J, bcs)
 
     return b, A, assemble
+
+
+def same_coefficients(F, J):
+    """Whether the forms ``F`` and ``J`` take the same coefficients in the same order (the
+    same Functions' storage), on the same integrals: their packed coefficients are then the
+    same arrays, and one packing serves both at one state."""
+
+    def storage(form):
+        return [c.x.array.__array_interface__["data"][0] for c in form.coefficients]
+
+    def integrals(form):
+        return [(t, tuple(form.integral_ids(t))) for t in form.integral_types]
+
+    return storage(F) == storage(J) and integrals(F) == integrals(J)

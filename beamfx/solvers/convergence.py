@@ -121,14 +121,14 @@ class AbsoluteTangent:
     def __init__(self, A):
         self.B = A.duplicate(copy=False)
         self.v, self.out = A.createVecs()
-        self._pattern = None  # (row pointers, columns) of B
+        self._pattern = None  # (row pointers, columns) of B, as bytes
 
     def floor(self, A, x, sizes):
         """ε‖ |A| (|x| + sizes) ‖₂ (``sizes``: local owned array or None). Collective."""
         rows, cols, vals = A.getValuesCSR()
-        same = self._pattern is not None and all(
-            np.array_equal(a, b) for a, b in zip(self._pattern, (rows, cols), strict=True)
-        )
+        # the same pattern: the same bytes (PETSc's index arrays, one dtype), compared without
+        # np.array_equal's dispatch (4 µs of a 11 µs estimate)
+        same = self._pattern is not None and self._pattern == (rows.tobytes(), cols.tobytes())
         comm = A.getComm()
         if comm.getSize() > 1:  # the copy is collective: every rank or none
             from mpi4py import MPI
@@ -137,7 +137,7 @@ class AbsoluteTangent:
         if not same:  # a new copy: the pattern may have grown (a coupling's entries added)
             self.B.destroy()
             self.B = A.duplicate(copy=True)
-            self._pattern = (rows, cols)
+            self._pattern = (rows.tobytes(), cols.tobytes())
         self.B.setValuesCSR(rows, cols, np.abs(vals))
         self.B.assemble()
         eps = np.finfo(float).eps

@@ -6,7 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .assembly import assemble_residual, assemble_tangent, prescribed
+from .assembly import assemble_residual, assemble_tangent, prescribed, same_coefficients
 from .blocked import use_node_blocks
 from .convergence import ScaledTest, diagnose, reason_names
 from .forms import compile_form
@@ -124,6 +124,9 @@ class NewtonSolver:
         self._kept = None  # (x, F before the conditions, lifted) of the last residual
         self._targets = None  # the prescribed values on the constrained rows, per solve
         self._constants = (None, None)  # F's and J's constants packed, per solve
+        # F's coefficients packed at the last residual's state (the state the tangent is
+        # then asked at): J's too when J takes the same coefficients (checked once: None)
+        self._packed, self._share = None, None
 
         snes = PETSc.SNES().create(w.function_space.mesh.comm)
         snes.setOptionsPrefix(prefix)
@@ -153,9 +156,11 @@ class NewtonSolver:
             self.coupling.update()
         kept = self._kept
         keep = kept[1] if kept else None
+        self._packed = packed = _pack_coefficients(self.F)
         local, lifted = assemble_residual(
-            b, self.F, self.J, self.bcs, x, self._rows, keep, self._targets, self._constants[0]
-        )
+            b, self.F, self.J, self.bcs, x, self._rows, keep, self._targets, self._constants[0],
+            packed,
+        )  # fmt: skip
         if kept:
             kept[0][:] = x.getArray(readonly=True)
             kept[2] = lifted
@@ -165,12 +170,21 @@ class NewtonSolver:
 
     def _jacobian(self, snes, x, A, P):
         t = time.perf_counter()
-        assemble_tangent(A, self.J, self.bcs, self._constants[1])
+        assemble_tangent(A, self.J, self.bcs, self._constants[1], self._tangent_coefficients())
         if self.coupling:
             self.coupling.add_to_tangent(A)
         if self.P is not None:  # the factored copy (its entries replaced, its storage kept)
             A.convert("dense", self.P)
         self.seconds["assemble_J"] += time.perf_counter() - t
+
+    def _tangent_coefficients(self):
+        """J's coefficients packed at the state of the last residual (SNES asks the tangent
+        where it evaluated the residual last, and only the residual moves ``w``): the
+        residual's packing when J takes the same coefficients (no coupling, whose
+        ``update()`` may change them), else None (packed by the assembly)."""
+        if self._share is None:
+            self._share = self.coupling is None and same_coefficients(self.F, self.J)
+        return self._packed if self._share else None
 
     def _test(self, snes, it, norms):
         t = time.perf_counter()
@@ -216,6 +230,7 @@ class NewtonSolver:
         from petsc4py import PETSc
 
         self._residuals = []
+        self._packed = None  # (a tangent before any residual packs its own)
         self.test.reset()
         # the prescribed values, fixed during the solve (whether a residual needs a lifting)
         self._targets = prescribed(self.bcs, self._rows, self.b.getLocalSize()).tolist()
@@ -272,6 +287,15 @@ class NewtonSolver:
 
 
 _reasons = {}
+
+
+def _pack_coefficients(form):
+    """``dolfinx.cpp.fem.pack_coefficients(form)`` (the same call), its import made once."""
+    from dolfinx.cpp.fem import pack_coefficients
+
+    global _pack_coefficients
+    _pack_coefficients = pack_coefficients
+    return pack_coefficients(form)
 
 
 def _reason_name(code):
