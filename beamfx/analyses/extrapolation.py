@@ -132,7 +132,9 @@ class Extrapolation:
         if not all(n in arrays for n in names):
             self.copies = None
             return
+        # with the predictor's history where saved (predictor.py; else order 0 once)
+        keys = ("q_n", "v_n", "a_n", "qdd_n", "a_rate", "a_curve", "a_steps")
         self.copies = {
-            c: {k: arrays[f"{c}_{k}"].copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
+            c: {k: arrays[f"{c}_{k}"].copy() for k in keys if f"{c}_{k}" in arrays}
             for c in self.COPIES
         }
