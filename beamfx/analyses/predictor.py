@@ -14,6 +14,10 @@ Newton further off than order 0; so each accepted step measures which order woul
 predicted its own a_{n+1} best, and the next step uses that one (:class:`AccelerationTrend`).
 At the start, and after a restart from a checkpoint without the trend, the order is 0: the old
 predictor, bit for bit.
+
+Used by the scheme "extrapolated" (:class:`~beamfx.analyses.dynamics.Dynamics` says why not by
+the plain ones): the spin-up's Richardson settings take 26 % fewer Newton iterations (4 x P2 at
+dt = 0.025: 4657 -> 3443) with the same values to 3e-8.
 """
 
 import numpy as np
