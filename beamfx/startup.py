@@ -67,10 +67,21 @@ def _real():
 
 class _VersionsOnly(types.ModuleType):
     """``pkg_resources`` for UFL and FFCx: ``get_distribution(name).version`` of
-    :data:`OWN_VERSION`'s names; every other name or attribute from the real module."""
+    :data:`OWN_VERSION`'s names, once each (their import's question); every other name or
+    attribute, and any later question, from the real module. Once both are answered it leaves
+    ``sys.modules``: a later ``import pkg_resources`` gets the real module."""
+
+    def __init__(self, name):
+        super().__init__(name)
+        self._unread = set(OWN_VERSION)
 
     def get_distribution(self, name):
-        version = dist_info_version(name, OWN_VERSION[name]) if name in OWN_VERSION else None
+        version = None
+        if name in self._unread:
+            self._unread.discard(name)
+            version = dist_info_version(name, OWN_VERSION[name])
+            if not self._unread and sys.modules.get("pkg_resources") is self:
+                del sys.modules["pkg_resources"]
         if version is None:
             return _real().get_distribution(name)
         return types.SimpleNamespace(project_name=name, version=version)
