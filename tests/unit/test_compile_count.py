@@ -263,6 +263,8 @@ def test_a_ready_jit_module_is_loaded_by_name_as_ffcx_finds_it(tmp_path):
     """The first lookup of a compiled module loads its extension file by name
     (forms._load_ready, no listing of the cache folder): the module FFCx's own lookup finds,
     with the same objects; a module not compiled or not marked ready is left to FFCx."""
+    import shutil
+
     import dolfinx
     import ufl
     from ffcx.codegeneration import jit
@@ -282,5 +284,7 @@ def test_a_ready_jit_module_is_loaded_by_name_as_ffcx_finds_it(tmp_path):
     assert found[1].__file__ == ffcx_module.__file__
     assert [str(o) for o in found[0]] == [str(o) for o in ffcx_objects]
     assert _load_ready("libffcx_forms_not_there", list(objects), folder) is None
-    (tmp_path / f"{name}.c").write_text("")  # being compiled elsewhere: not ready
+    # being compiled elsewhere: its C file and extension file there, not yet marked ready
+    (tmp_path / f"{name}.c").write_text("")
+    shutil.copy(ffcx_module.__file__, tmp_path)
     assert _load_ready(name, list(objects), tmp_path) is None
