@@ -76,8 +76,8 @@ class AccelerationTrend:
     def _best(self, d, h):
         """The order (≤ the differences known) whose guess of a_{n+1} - a_n was nearest the
         step's ``d``: least squares over the owned entries, summed over the ranks."""
-        n, tmp = self.owned, self._work[1]
-        e = d.copy()
+        n, e, tmp = self.owned, self._work[0], self._work[1]
+        e[:] = d  # (the work array accept fills after this)
         norms = [float(e[:n] @ e[:n])]
         np.subtract(e, np.multiply(h, self.rate, out=tmp), out=e)
         norms.append(float(e[:n] @ e[:n]))
