@@ -34,6 +34,7 @@ in time and start with zero acceleration (the run starts at rest, q̈ = 0).
 """
 
 from ..solvers.integrators import richardson
+from .predictor import STATE_KEYS
 
 
 class Extrapolation:
@@ -101,7 +102,9 @@ class Extrapolation:
             reports += more
         dyn.set_state(shown)
         if coarse is not None:
-            both = {k: richardson(coarse[k], fine[k]) for k in fine}
+            # the copies' predictor histories are their own (every step starts from a copy):
+            # not combined, the shown state has none
+            both = {k: richardson(coarse[k], fine[k]) for k in fine if k not in STATE_KEYS}
             self._new = {"coarse": coarse, "fine": fine}, both, richardson(r_coarse, r_fine)
             dyn.model.w.x.array[:] = both["q_n"]
             dyn.h.value = h
@@ -133,7 +136,7 @@ class Extrapolation:
             self.copies = None
             return
         # with the predictor's history where saved (predictor.py; else order 0 once)
-        keys = ("q_n", "v_n", "a_n", "qdd_n", "a_rate", "a_curve", "a_steps")
+        keys = ("q_n", "v_n", "a_n", "qdd_n", *STATE_KEYS)
         self.copies = {
             c: {k: arrays[f"{c}_{k}"].copy() for k in keys if f"{c}_{k}" in arrays}
             for c in self.COPIES

@@ -24,6 +24,8 @@ import numpy as np
 
 #: the highest order of the extrapolation (2: quadratic through a_{n-2}, a_{n-1}, a_n)
 MAX_ORDER = 2
+#: the names of :meth:`AccelerationTrend.state`'s arrays in a checkpoint
+STATE_KEYS = ("a_rate", "a_curve", "a_steps")
 
 
 class AccelerationTrend:
@@ -95,7 +97,7 @@ class AccelerationTrend:
 
     def set_state(self, arrays):
         """Restore :meth:`state`; without it (an older checkpoint) no history: order 0."""
-        if not all(k in arrays for k in ("a_rate", "a_curve", "a_steps")):
+        if not all(k in arrays for k in STATE_KEYS):
             self.reset()
             return
         self.rate[:] = arrays["a_rate"]
