@@ -171,8 +171,9 @@ class Dynamics:
     def predict(self, h):
         """Newton's starting point: the generalized-α update of q with the acceleration
         extrapolated from the last steps (:mod:`~beamfx.analyses.predictor`; the scheme
-        "extrapolated" only, see ``trend``; else and at the start: unchanged acceleration), and the prescribed values of the supports at t_{n+1} (a
-        mismatch there would start Newton from a state with a sudden strain at the support)."""
+        "extrapolated" only, see ``trend``; else and at the start: unchanged acceleration),
+        and the prescribed values of the supports at t_{n+1} (a mismatch there would start
+        Newton from a state with a sudden strain at the support)."""
         q_n, v_n, a_n, _ = self.state_values
         w, tmp = self.w_values, self._work[0]
         # AlphaStep.predict in place (the same operations): q_n + h v_n + (h² ½) a_n
