@@ -107,6 +107,9 @@ def light_versions():
 
 
 def prepare():
-    """Both, before anything imports mpi4py, UFL or FFCx (:func:`beamfx.cli.main`)."""
+    """Both, before anything imports mpi4py, UFL or FFCx (:func:`beamfx.cli.main`); the
+    stand-in only while UFL or FFCx is still to be imported (a second ``main`` in one process,
+    a test's, has nothing to save and would leave it in place)."""
     mpi_singleton()
-    light_versions()
+    if not all(package in sys.modules for package in OWN_VERSION.values()):
+        light_versions()
