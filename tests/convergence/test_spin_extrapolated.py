@@ -13,6 +13,7 @@ def _values(case, setting, folder):
     from beamfx.bench.transient import read_history
 
     run, _ = run_in_process(case.scene(*setting), folder)
+    assert run.converged, f"{setting}: {run.result.status}: {run.result.reason}"
     values = case.measure(read_history(folder, "tip"), None)
     return values, run.result.time_steps
 
