@@ -44,8 +44,9 @@ class RunContext:
     _points: list | None = field(default=None, init=False, repr=False)  # the probes' points
     latest_reactions: dict | None = None  # results.json entries of the last reactions
     _reaction_csv: object = field(default=None, init=False, repr=False)  # reactions.csv
-    #: wall time (s) of the per-step output of :meth:`step` and :meth:`last_frame`: probes (the
-    #: first evaluation loads the section expression), reactions (with reactions.csv), frames
+    #: wall time (s) of the per-step output of :meth:`step` and :meth:`last_frame` (and of a
+    #: transient's steps, inside its own "total"): probes (the first evaluation loads the
+    #: section expression; a transient's with probes.csv), reactions (with reactions.csv), frames
     seconds: dict = field(default_factory=lambda: dict.fromkeys(OUTPUT_PARTS, 0.0))
 
     def reactions(self, model):
@@ -69,6 +70,18 @@ class RunContext:
         values = evaluate_points(model, self._points, full=full)
         self.latest = track_rotations(self.latest if track else None, values)
         return self.latest
+
+    def probe_blocks(self, model):
+        """The per-step recorder of the probes' points for a transient's history
+        (:class:`~beamfx.io.probe_blocks.ProbeBlocks`), tracking on from :attr:`latest`; each
+        drained block's last values become :attr:`latest`. Collective."""
+        from ..io.probe_blocks import ProbeBlocks
+
+        def keep(values):
+            self.latest = values
+
+        points = list(dict.fromkeys(self.probes.values()))
+        return ProbeBlocks(model, points, self.comm, self.latest, keep)
 
     def step(self, model, step, time):
         """After an accepted step (static, arc length): probes tracked, the reactions (a row

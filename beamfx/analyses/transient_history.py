@@ -1,13 +1,15 @@
 """``probes.csv`` and ``probes.jsonl`` of a transient run: a row and a line per accepted step.
 
-The rows are kept as the numbers of each step and written in blocks (rank 0): at every frame
-step (:mod:`~beamfx.analyses.transient_run` flushes there), before every checkpoint (a
-restart finds the rows up to it), once at least :data:`FLUSH_SECONDS` of wall time have passed
-since the last block, at the end, and when the run fails or is stopped by a signal (the
-history is closed then). A block is formatted by one format operation over all its numbers
-(``{:.12g}`` in the csv, ``repr`` in the jsonl, as ``json.dumps`` writes a float), so the
-files hold the same text, byte for byte, as a line formatted per step. A process killed
-outright loses at most the rows since the last block.
+At every step only the step's numbers and the probes' raw kinematics are kept
+(:class:`~beamfx.io.probe_blocks.ProbeBlocks`, a copy of a few numbers); the rows are made and
+written in blocks (rank 0) at every frame step (:mod:`~beamfx.analyses.transient_run` flushes
+there), before every checkpoint (a restart finds the rows up to it), when a block is full,
+once at least :data:`FLUSH_SECONDS` of wall time have passed since the last block, at the end,
+and when the run fails or is stopped by a signal (the history is closed then). Flushing is
+collective (the probes' values are gathered on rank 0). A block is formatted by one format
+operation over all its numbers (``{:.12g}`` in the csv, ``repr`` in the jsonl, as
+``json.dumps`` writes a float), so the files hold the same text, byte for byte, as a line
+formatted per step. A process killed outright loses at most the rows since the last block.
 """
 
 import json
@@ -26,6 +28,7 @@ ENERGY_KEYS = (
 )
 PROBE_KEYS = ("position", "displacement", "rotation_vector_unwrapped")
 FLUSH_SECONDS = 2.0  # the rows are on disk at most this much wall time after their step
+CLOCK_STEPS = 16  # with several ranks, rank 0's clock is asked every this many steps
 
 
 def columns(probes):
@@ -60,12 +63,14 @@ class History:
         folder: the output folder.
         probes: ``{probe name: point name}``.
         comm: the run's communicator (rank 0 writes).
+        blocks: the :class:`~beamfx.io.probe_blocks.ProbeBlocks` of the probes' points.
         t_restart: the checkpoint's time on a restart: the rows after it are cut away.
     """
 
-    def __init__(self, folder, probes, comm, t_restart=None):
+    def __init__(self, folder, probes, comm, blocks, t_restart=None):
         self.csv, self.jsonl = folder / "probes.csv", folder / "probes.jsonl"
-        self.probes, self.root = probes, comm.rank == 0
+        self.probes, self.root, self.comm, self.blocks = probes, comm.rank == 0, comm, blocks
+        self.columns = [blocks.points.index(at) for at in probes.values()]
         self.files, self.rows, self.formats = None, [], {}
         self.flushed = time.perf_counter()
         if not self.root:
@@ -88,22 +93,33 @@ class History:
         keep = [x for x in lines if _entry_time(x) <= t_max]
         self.jsonl.write_text("".join(x + "\n" for x in keep))
 
-    def add(self, r, values):
-        """The row of step record ``r`` with the tracked probe ``values`` (kept; written with
-        the next block)."""
-        if not self.root:
-            return
-        points = [values[at] for at in self.probes.values()]
-        self.rows.append((r.step, r.time, r.dt, r.iterations, r.cutbacks, points, r.energy))
-        if time.perf_counter() - self.flushed >= FLUSH_SECONDS:
+    def add(self, r):
+        """The row of step record ``r`` and the probes' state now (kept; written with the next
+        block, which may be now). Collective."""
+        self.blocks.record()
+        if self.root:
+            self.rows.append((r.step, r.time, r.dt, r.iterations, r.cutbacks, r.energy))
+        if self.blocks.full or self._clock_due(len(self.rows) if self.root else None):
             self.flush()
 
+    def _clock_due(self, kept):
+        """Whether :data:`FLUSH_SECONDS` have passed since the last block: rank 0's clock,
+        asked at every step on one rank, every :data:`CLOCK_STEPS` kept steps on several."""
+        if self.comm.size == 1:
+            return time.perf_counter() - self.flushed >= FLUSH_SECONDS
+        if self.blocks.count % CLOCK_STEPS:
+            return False
+        due = self.root and time.perf_counter() - self.flushed >= FLUSH_SECONDS
+        return self.comm.bcast(due, root=0)
+
     def flush(self):
-        """Write the rows kept as one block and flush the probe files (rank 0)."""
+        """Make the rows kept into a block, write it and flush the probe files (rank 0).
+        Collective."""
+        table = self.blocks.drain()
         if self.files is None:
             return
         if self.rows:
-            csv, jsonl = self._block(self.rows)
+            csv, jsonl = self._block(self.rows, table[:, self.columns])
             self.files[0].write(csv)
             self.files[1].write(jsonl)
             self.rows = []
@@ -111,15 +127,12 @@ class History:
             f.flush()
         self.flushed = time.perf_counter()
 
-    def _block(self, rows):
-        """(csv text, jsonl text) of ``rows``."""
+    def _block(self, rows, table):
+        """(csv text, jsonl text) of ``rows`` and their probes' ``table`` (rows, probes, 9)."""
         numbers, formats, values = [], [], []
-        for step, t, dt, iterations, cutbacks, points, energy in rows:
-            flat = []
-            for v in points:
-                flat += v["position"]
-                flat += v["displacement"]
-                flat += v["rotation_vector_unwrapped"]
+        for (step, t, dt, iterations, cutbacks, energy), flat in zip(
+            rows, table.reshape(len(rows), -1).tolist()
+        ):
             numbers += (step, t, dt, iterations, cutbacks, *flat)
             numbers += [energy[k] for k in ENERGY_KEYS]
             spent = list(energy.values())
@@ -131,7 +144,7 @@ class History:
                 formats.append(self.formats[keys])
                 values += (step, t, dt, iterations, *flat, *spent)
             else:  # lists (a free body's momenta) or non-finite values: as json writes them
-                formats.append(_entry(self.probes, step, t, dt, iterations, points, energy))
+                formats.append(_entry(self.probes, step, t, dt, iterations, flat, energy))
         csv = (self.row_format * len(rows)).format(*numbers)
         return csv, "".join(formats) % tuple(values)
 
@@ -143,11 +156,13 @@ class History:
         self.files = None
 
 
-def _entry(probes, step, t, dt, iterations, points, energy):
-    """The jsonl line of a step through ``json.dumps``, its ``%`` doubled (a format's text)."""
+def _entry(probes, step, t, dt, iterations, flat, energy):
+    """The jsonl line of a step through ``json.dumps``, its ``%`` doubled (a format's text);
+    ``flat``: the probes' 9 numbers each (position, displacement, unwrapped rotation)."""
     entry = {"step": step, "time": t, "dt": dt, "iterations": iterations, "probes": {}}
-    for name, v in zip(probes, points):
-        entry["probes"][name] = {k: v[k] for k in PROBE_KEYS}
+    for i, name in enumerate(probes):
+        v = flat[9 * i : 9 * i + 9]
+        entry["probes"][name] = {k: v[3 * j : 3 * j + 3] for j, k in enumerate(PROBE_KEYS)}
     entry["energy"] = energy
     return (json.dumps(entry) + "\n").replace("%", "%%")
 

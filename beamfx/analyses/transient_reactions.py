@@ -34,6 +34,7 @@ goes (rank 0; the writer a static run uses too, :mod:`beamfx.io.reaction_files`)
 and the largest values over the run.
 """
 
+import time
 from typing import NamedTuple
 
 import numpy as np
@@ -42,6 +43,8 @@ from ..io.reaction_files import ReactionCsv, columns
 from ..physics.rotations import _norm  # np.linalg.norm's value, without its checks
 from .dofs import constrained_dofs, owned_size
 from .reactions import ReactionRecovery
+
+_now = time.perf_counter
 
 
 class DynamicBalance(NamedTuple):
@@ -171,6 +174,7 @@ class ReactionSeries:
         self.t_restart = t_restart
         self.csv = ReactionCsv(self.path, comm)
         self.compute = self.latest = None
+        self.seconds = 0.0  # wall time of the output steps' reactions and rows
 
     def start(self, dyn, residual, loads):
         """Compile what the reactions need (``residual`` and ``loads``: the compiled forms of
@@ -185,12 +189,14 @@ class ReactionSeries:
         """The reactions of a converged step, if it is an output step. Collective."""
         if not self.want(step, time, last):
             return
+        t0 = _now()
         reactions, balance = self.compute(residual)
         forces = {at: r.force for at, r in reactions.items()}
         moments = {at: r.moment for at, r in reactions.items()}
         self.peaks.add(time, forces, moments, (balance.force, balance.moment))
         self.latest = (step, time, reactions, balance)
         self.csv.write(_row(step, time, reactions, balance))
+        self.seconds += _now() - t0
 
     def at_step(self, step):
         """``{point: {force, moment, position}}`` of output step ``step`` if its reactions

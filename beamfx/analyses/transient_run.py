@@ -9,6 +9,7 @@ energy balance), written in blocks (:mod:`~beamfx.analyses.transient_history`); 
 steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -26,6 +27,7 @@ if TYPE_CHECKING:  # heavy (UFL, PETSc): imported where used
     from ..spec import Model
     from .transient import TransientSettings
 
+_now = time.perf_counter
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
 
 
@@ -237,17 +239,22 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         ctx.log(f"warning: {w}")
     saved = _start(model, settings, ctx)
     t_restart = saved[0]["t"] if saved else None
-    history = History(ctx.folder, ctx.probes, ctx.comm, t_restart)
+    history = History(ctx.folder, ctx.probes, ctx.comm, ctx.probe_blocks(model), t_restart)
     series = ReactionSeries(ctx.folder, ctx.comm, _reaction_steps(ctx), t_restart)
-    energy = {}
+    energy, seconds = {}, ctx.seconds
 
     def on_step(r):
-        values = ctx.probe_values(model, full=False)
+        t0 = _now()
         energy.update(r.energy)
-        history.add(r, values)
+        history.add(r)
+        t1 = _now()
+        seconds["probes"] += t1 - t0
         if ctx.frames.want(r.step, r.time):
             history.flush()
+            t2 = _now()
             ctx.frames.write(r.step, r.time, series.at_step(r.step))
+            seconds["probes"] += t2 - t1
+            seconds["frames"] += _now() - t2
 
     bar, progress = _progress(model.comm, settings.t_end)
     try:
@@ -264,12 +271,16 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
                 reactions=series,
             )
     except TransientFailed:  # collective; the model holds the last accepted state again
+        history.flush()  # the rows kept, and the rotations tracked up to that state
         ctx.probe_values(model)  # its full values, for results.json
         raise
     finally:
         bar.close()
+        t0 = _now()
         history.close()
+        seconds["probes"] += _now() - t0
         series.close()
+        seconds["reactions"] += series.seconds
         ctx.latest_reactions = series.entries()
     if result.steps:
         last = result.steps[-1]

@@ -60,11 +60,10 @@ def _plan(model, names):
     return per_model[key]
 
 
-def _kinematics(model, names, recover):
-    """{name: :func:`_kinematic_values`} of the named points this rank evaluates: the compiled
-    expression of :func:`~beamfx.io._sections.evaluate` (the same numbers) without its
-    per-call set-up; what a history asks at every step. Its plan is cached per model,
-    names and ``recover`` (the expression's points)."""
+def kinematics_plan(model, names, recover):
+    """(rows [(name, node)], cells, compiled expression, its values' buffer, a (cells,
+    points, quantities) view of it, slices of X, u and the rotation) of the named points
+    this rank evaluates: cached per model, names and ``recover`` (the expression's points)."""
     per_model = _plans.get(model)
     key = ("kinematics", tuple(names), recover)
     plan = per_model.get(key) if per_model is not None else None
@@ -77,7 +76,15 @@ def _kinematics(model, names, recover):
         buffer = np.zeros((len(cells), expr.X().shape[0] * expr.value_size), expr.dtype)
         values = buffer.reshape(len(rows), len(sample), expr.value_size)  # a view of it
         plan = _plans[model][key] = (rows, cells, expr, buffer, values, parts)
-    rows, cells, expr, buffer, values, (X, u, rot) = plan
+    return plan
+
+
+def _kinematics(model, names, recover):
+    """{name: :func:`_kinematic_values`} of the named points this rank evaluates: the compiled
+    expression of :func:`~beamfx.io._sections.evaluate` (the same numbers) without its
+    per-call set-up; what a history asks at every step. Its plan is cached per model,
+    names and ``recover`` (the expression's points)."""
+    rows, cells, expr, buffer, values, (X, u, rot) = kinematics_plan(model, names, recover)
     if not rows:
         return {}
     expr.eval(cells, buffer)  # into the kept array (Expression.eval's values argument)

@@ -13,7 +13,7 @@ from beamfx.analyses.transient_history import ENERGY_KEYS, History, columns
 from beamfx.scene.expr import compile_expression
 
 SPIN = "where(t < 15, (6/15) * (t**2/2 + (15/(2*pi))**2 * (cos(2*pi*t/15) - 1)), 6*t - 45)"
-ROOT = SimpleNamespace(rank=0)
+ROOT = SimpleNamespace(rank=0, size=1)
 PROBES = {"tip": "beam:end", 'odd %s "name"': "beam:mid"}
 
 
@@ -66,13 +66,47 @@ def _records(n, rng):
     return out
 
 
+class _Blocks:
+    """A stand-in for :class:`~beamfx.io.probe_blocks.ProbeBlocks`: keeps the values handed
+    to it (``pending``) at each record and drains them as the (rows, points, 9) table."""
+
+    full = False
+
+    def __init__(self, points):
+        self.points, self.kept, self.pending = list(dict.fromkeys(points)), [], None
+
+    @property
+    def count(self):
+        return len(self.kept)
+
+    def record(self):
+        self.kept.append(self.pending)
+
+    def drain(self):
+        if not self.kept:
+            return None
+        keys = transient_history.PROBE_KEYS
+        table = [[[x for k in keys for x in v[at][k]] for at in self.points] for v in self.kept]
+        self.kept = []
+        return np.array(table)
+
+
+def _history(folder, t_restart=None):
+    return History(folder, PROBES, ROOT, _Blocks(PROBES.values()), t_restart)
+
+
+def _add(history, r, values):
+    history.blocks.pending = values
+    history.add(r)
+
+
 def test_blocks_are_the_row_by_row_text(tmp_path, monkeypatch):
     """Random records (non-finite values and momenta among them) written in blocks of several
     sizes: both files are byte for byte those written row by row."""
     records = _records(400, np.random.default_rng(3))
-    history = History(tmp_path, PROBES, ROOT)
+    history = _history(tmp_path)
     for i, (r, values) in enumerate(records):
-        history.add(r, values)
+        _add(history, r, values)
         if i % 37 == 5:  # blocks of varied sizes, as frames and checkpoints make them
             history.flush()
     history.close()
@@ -86,16 +120,16 @@ def test_rows_reach_the_files_at_a_flush_or_after_the_time_limit(tmp_path, monke
     passed, and the rest when the history is closed (the end, a failure, a signal)."""
     records = _records(6, np.random.default_rng(5))
     csv = tmp_path / "probes.csv"
-    history = History(tmp_path, PROBES, ROOT)
-    history.add(*records[0])
+    history = _history(tmp_path)
+    _add(history, *records[0])
     assert len(csv.read_text().splitlines()) == 1  # the header only
     history.flush()
     assert len(csv.read_text().splitlines()) == 2
     monkeypatch.setattr(transient_history, "FLUSH_SECONDS", 0.0)
-    history.add(*records[1])  # the time limit passed: written at once
+    _add(history, *records[1])  # the time limit passed: written at once
     assert len(csv.read_text().splitlines()) == 3
     monkeypatch.setattr(transient_history, "FLUSH_SECONDS", 1e9)
-    history.add(*records[2])
+    _add(history, *records[2])
     assert len(csv.read_text().splitlines()) == 3
     history.close()
     assert len(csv.read_text().splitlines()) == 4
@@ -106,14 +140,14 @@ def test_a_restart_keeps_the_rows_up_to_its_checkpoint(tmp_path):
     """A restart at a checkpoint's time keeps the rows written up to it (flushed before the
     checkpoint) and goes on after them."""
     records = _records(10, np.random.default_rng(9))
-    history = History(tmp_path, PROBES, ROOT)
+    history = _history(tmp_path)
     for r, values in records[:6]:
-        history.add(r, values)
+        _add(history, r, values)
     history.flush()  # what the checkpoint writer does first
     history.close()
-    history = History(tmp_path, PROBES, ROOT, t_restart=records[4][0].time)
+    history = _history(tmp_path, t_restart=records[4][0].time)
     for r, values in records[5:]:
-        history.add(r, values)
+        _add(history, r, values)
     history.close()
     csv, jsonl = _reference(PROBES, records)
     assert (tmp_path / "probes.csv").read_text() == csv
