@@ -49,8 +49,10 @@ class ProbeBlocks:
             [i * size + node * expr.value_size + parts for i, (_, node) in enumerate(rows)],
             dtype=np.intp,
         ).reshape(len(rows), len(parts))
-        self.expr, self.cells, self.flat = expr, cells, buffer.reshape(-1)
-        self.buffer = buffer
+        # the compiled expression's own eval (Expression.eval's call, without its per-call
+        # shape checks: the buffer was made for it), the values' buffer and its flat view
+        self.eval, self.cells = expr._cpp_object.eval, cells
+        self.buffer, self.flat = buffer, buffer.reshape(-1)
         self.raw = np.empty((capacity, len(rows), len(parts)))
         self.count, self.capacity = 0, capacity
         previous = previous or {}
@@ -69,8 +71,8 @@ class ProbeBlocks:
         """Keep the current state's raw kinematics (collective: the model's derived fields)."""
         self.model.sync()
         if len(self.index):
-            self.expr.eval(self.cells, self.buffer)
-            np.take(self.flat, self.index, out=self.raw[self.count])
+            self.eval(self.cells, self.buffer)
+            self.raw[self.count] = self.flat[self.index]
         self.count += 1
 
     def drain(self):
