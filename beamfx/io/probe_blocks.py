@@ -130,10 +130,13 @@ def _check_found(points, local, comm):
 
 
 def _axes_angles(q):
-    """Unit axes (n, 3) and angles in [0, 2π] (n,) of quaternions (n, 4) of any norm:
-    :func:`~beamfx.physics.rotations.unwrap_rotation_vector`'s first operations, per row."""
-    norm = np.sqrt(_dots(q))
-    q = q / norm[:, None]
+    """Unit axes (n, 3) and angles in [0, 2π] (n,) of quaternions (n, 4) of any norm, per row
+    the operations of the per-step path: the probe's ``quaternion`` (q / |q|,
+    :func:`~beamfx.io.probes.evaluate_points`), then
+    :func:`~beamfx.physics.rotations.unwrap_rotation_vector`'s first operations on it (which
+    normalise it once more: not always the same bits)."""
+    q = q / np.sqrt(_dots(q))[:, None]
+    q = q / np.sqrt(_dots(q))[:, None]
     s = np.sqrt(_dots(q[:, 1:]))
     angles = 2 * np.arctan2(s, q[:, 0])
     ok = s > 1e-300

@@ -36,14 +36,15 @@ def _one_point_blocks(finite):
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_block_unwrap_is_bitwise_the_per_step_unwrap(seed):
-    """The block's axes, angles and turns: bitwise those of unwrap_rotation_vector step by
-    step, from the undeformed state and from a checkpoint's value several turns away."""
+    """The block's axes, angles and turns: bitwise those of the per-step path (the unit
+    quaternion of evaluate_points, then unwrap_rotation_vector) step by step, from the undeformed state and from a checkpoint's value several turns away."""
     rng = np.random.default_rng(seed)
     q = _path(500, rng)
     for start in ([0.0, 0.0, 0.0], (4 * np.pi * np.array([0.6, 0.0, 0.8])).tolist()):
         want, theta = [], start
-        for row in q.tolist():
-            theta = unwrap_rotation_vector(row, theta)
+        for row in q.tolist():  # the probe's unit quaternion, as evaluate_points gives it
+            norm = math.sqrt(np.dot(row, row))
+            theta = unwrap_rotation_vector([c / norm for c in row], theta)
             want.append(theta)
         got = _one_point_blocks(True)._unwrapped(q, start)
         assert got.tobytes() == np.array(want).tobytes()
@@ -51,7 +52,8 @@ def test_block_unwrap_is_bitwise_the_per_step_unwrap(seed):
 
 def _states(model, n):
     """n states of the model's unknowns: the solved roll-up's displacements scaled and its
-    rotations' angles about their axes scaled (up to 6 × the quarter turn: 1.5 turns)."""
+    rotations' angles about their axes scaled (up to 6 × the quarter turn: 1.5 turns), the
+    quaternions' norms too."""
     _, dofs = model.W.sub(1).collapse()
     dofs = np.asarray(dofs).reshape(-1, 4)  # the quaternions' rows (4 components per node)
     base = model.w.x.array.copy()
@@ -60,7 +62,8 @@ def _states(model, n):
     axes = q[:, 1:] / np.maximum(np.linalg.norm(q[:, 1:], axis=1), 1e-300)[:, None]
     for s in np.linspace(0.1, 6.0, n):
         model.w.x.array[:] = s * base
-        model.w.x.array[dofs] = np.c_[np.cos(s * half), np.sin(s * half)[:, None] * axes]
+        q = np.c_[np.cos(s * half), np.sin(s * half)[:, None] * axes]
+        model.w.x.array[dofs] = (1.0 + 0.3 * s) * q  # not of unit norm (rotations all the same)
         model.w.x.scatter_forward()
         yield
 
