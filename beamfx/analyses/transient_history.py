@@ -99,12 +99,13 @@ class History:
         self.blocks.record()
         if self.root:
             self.rows.append((r.step, r.time, r.dt, r.iterations, r.cutbacks, r.energy))
-        if self.blocks.full or self._clock_due(len(self.rows) if self.root else None):
+        if self.blocks.full or self._clock_due():
             self.flush()
 
-    def _clock_due(self, kept):
+    def _clock_due(self):
         """Whether :data:`FLUSH_SECONDS` have passed since the last block: rank 0's clock,
-        asked at every step on one rank, every :data:`CLOCK_STEPS` kept steps on several."""
+        asked at every step on one rank, every :data:`CLOCK_STEPS` kept steps on several
+        (broadcast: the flush is collective)."""
         if self.comm.size == 1:
             return time.perf_counter() - self.flushed >= FLUSH_SECONDS
         if self.blocks.count % CLOCK_STEPS:
