@@ -49,9 +49,8 @@ class ProbeBlocks:
             [i * size + node * expr.value_size + parts for i, (_, node) in enumerate(rows)],
             dtype=np.intp,
         ).reshape(len(rows), len(parts))
-        # the compiled expression's own eval (Expression.eval's call, without its per-call
-        # shape checks: the buffer was made for it), the values' buffer and its flat view
-        self.eval, self.cells = expr._cpp_object.eval, cells
+        # the compiled expression's eval into the values' buffer (and its flat view)
+        self.eval, self.cells = expr.eval, cells
         self.buffer, self.flat = buffer, buffer.reshape(-1)
         self.raw = np.empty((capacity, len(rows), len(parts)))
         self.count, self.capacity = 0, capacity
