@@ -19,6 +19,7 @@ from .probes import kinematics_plan
 
 CAPACITY = 256  # steps per block (a full block is drained: memory does not grow with the run)
 _TWO_PI = 2 * np.pi
+_X_AXIS = np.array([1.0, 0.0, 0.0])  # the axis of a rotation of angle 0
 
 
 class ProbeBlocks:
@@ -139,7 +140,9 @@ def _axes_angles(q):
     s = np.sqrt(_dots(q[:, 1:]))
     angles = 2 * np.arctan2(s, q[:, 0])
     ok = s > 1e-300
-    axes = np.where(ok[:, None], q[:, 1:] / np.where(ok, s, 1.0)[:, None], [1.0, 0.0, 0.0])
+    if ok.all():  # (the usual case: no rotation of angle 0 to the last bit)
+        return q[:, 1:] / s[:, None], angles
+    axes = np.where(ok[:, None], q[:, 1:] / np.where(ok, s, 1.0)[:, None], _X_AXIS)
     return axes, angles
 
 
