@@ -15,10 +15,10 @@ import math
 
 import numpy as np
 
+from ..physics.rotations import nearest_turn
 from .probes import kinematics_plan
 
 CAPACITY = 256  # steps per block (a full block is drained: memory does not grow with the run)
-_TWO_PI = 2 * np.pi
 _X_AXIS = np.array([1.0, 0.0, 0.0])  # the axis of a rotation of angle 0
 
 
@@ -117,7 +117,7 @@ class ProbeBlocks:
         out = np.empty((len(rot), 3))
         p = list(previous)
         for i, (n, angle) in enumerate(zip(axes.tolist(), angles.tolist())):
-            p = out[i] = _nearest_turn(n, angle, p)
+            p = out[i] = nearest_turn(n, angle, p)
         return out
 
 
@@ -152,22 +152,6 @@ def _dots(a):
     for j in range(1, a.shape[1]):
         out = out + a[:, j] * a[:, j]
     return out
-
-
-def _nearest_turn(n, angle, p):
-    """Of (angle + 2πk) n the one nearest to ``p``: the choice of
-    :func:`~beamfx.physics.rotations.unwrap_rotation_vector`, in plain floats."""
-    k0 = math.ceil(math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / _TWO_PI)
-    centre = round((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - angle) / _TWO_PI)
-    best, best_x = None, None
-    for k in range(max(centre - 1, -k0 - 2), min(centre + 1, k0 + 2) + 1):
-        c = angle + _TWO_PI * k
-        x = [c * n[0], c * n[1], c * n[2]]
-        d = [x[0] - p[0], x[1] - p[1], x[2] - p[2]]
-        dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-        if best is None or dist < best:
-            best, best_x = dist, x
-    return best_x
 
 
 def _values(row):

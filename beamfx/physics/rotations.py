@@ -168,19 +168,24 @@ def unwrap_rotation_vector(q, previous):
         n = [a / s, b / s, c / s]
     else:
         n = [1.0, 0.0, 0.0]
-    prev = np.asarray(previous, dtype=float)
-    k0 = math.ceil(_norm(prev) / (2 * np.pi))
-    # |(φ + 2πk) n - prev| is least at the integer nearest to (n·prev - φ)/2π: of the turns
-    # -k0-2 .. k0+2 only that one and its neighbours are compared, in plain floats (the same
-    # operations as arrays of all the turns would do, at a tenth of the cost per call)
-    p = prev.tolist()
+    return np.array(nearest_turn(n, angle, np.asarray(previous, dtype=float).tolist()))
+
+
+def nearest_turn(n, angle, p):
+    """Of the rotation vectors (``angle`` + 2πk) ``n`` (k integer) the one nearest to ``p``,
+    as a list; ``n`` (unit axis), ``p`` lists of 3 floats.
+
+    |(φ + 2πk) n - p| is least at the integer nearest to (n·p - φ)/2π: of the turns -k0-2 ..
+    k0+2 only that one and its neighbours are compared, in plain floats (the same operations
+    as arrays of all the turns would do, at a tenth of the cost per call)."""
+    k0 = math.ceil(math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / (2 * np.pi))
     centre = round((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - angle) / (2 * np.pi))
-    best = None
+    best, best_x = None, None
     for k in range(max(centre - 1, -k0 - 2), min(centre + 1, k0 + 2) + 1):
         c = angle + 2 * np.pi * k
         x = [c * n[0], c * n[1], c * n[2]]
         d = [x[0] - p[0], x[1] - p[1], x[2] - p[2]]
         dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-        if best is None or dist < best[0]:
-            best = (dist, x)
-    return np.array(best[1])
+        if best is None or dist < best:
+            best, best_x = dist, x
+    return best_x
