@@ -28,6 +28,18 @@ from .section_fields import section_kinetic_energy
 from .strain_rates import StrainHistory, bdf2_weights
 
 
+def _trend(settings, size, owned, comm):
+    """The accelerations' history for Newton's starting point (:mod:`.predictor`), for the
+    Richardson scheme's copies only (None: the start with unchanged acceleration). The plain
+    generalized-α spin-up at dt = 0.025 (Ω·dt = 0.15, ρ∞ = 0.9) sits at a slowly growing
+    instability of the scheme that Newton's error at its tolerance seeds; the extrapolated
+    start saves one iteration there, leaves that error larger (still within the tolerance)
+    and the 2 x P2 run then fails at t = 17.3 s (with the old start it runs through)."""
+    if settings.scheme != "extrapolated":
+        return None
+    return AccelerationTrend(size, owned, comm)
+
+
 class Dynamics:
     """Residual and Jacobian of one time step, and the energy forms, for a :class:`BeamModel`.
 
@@ -48,23 +60,14 @@ class Dynamics:
         self.state_values = tuple(f.x.array for f in (self.q_n, self.v_n, self.a_n, self.qdd_n))
         # work arrays of predict and accept, made once (no arrays made per step)
         self._work = tuple(np.empty_like(self.w_values) for _ in range(4))
-        # the accelerations' history, for Newton's starting point (predictor.py), used by the
-        # Richardson scheme's copies only: the plain generalized-α spin-up at dt = 0.025
-        # (Ω·dt = 0.15, ρ∞ = 0.9) sits at a slowly growing instability of the scheme that
-        # Newton's error at its tolerance seeds; the extrapolated start saves one iteration
-        # there, leaves that error larger (still within the tolerance) and the 2 x P2 run then
-        # fails at t = 17.3 s (the old start: it runs through). None: the old start.
-        self.trend = None
-        if settings.scheme == "extrapolated":
-            self.trend = AccelerationTrend(len(self.w_values), owned_size(W), model.comm)
+        self.trend = _trend(settings, len(self.w_values), owned_size(W), model.comm)
         # dofs per node: displacement (with the nodes' reference positions) and rotation
         V_u, u_dofs = W.sub(0).collapse()
         self.u_dofs = np.asarray(u_dofs).reshape(-1, kin.displacement_size)
         self.u_points = V_u.tabulate_dof_coordinates()
         self.extrapolation = None  # the scheme "extrapolated"'s copies (set by its march)
         self.r_dofs = subspace_dofs(W, 1).reshape(-1, kin.rotation_size)
-        self._is_displacement = np.zeros(len(self.q_n.x.array), bool)
-        self._is_displacement[self.u_dofs.ravel()] = True
+        self._is_displacement = np.isin(np.arange(len(self.w_values)), self.u_dofs)
         self._quaternion = kin.finite and not kin.plane
         self.project_rates = self._quaternion  # see _tangent_rates (and extrapolation.py)
         mesh = model.mesh.mesh
