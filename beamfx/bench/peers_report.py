@@ -18,7 +18,7 @@ Times (seconds; each record's fields):
 The verdict uses whole runs; the solve-only verdict stands beside it.
 """
 
-from .peers_score import line, summary
+from .peers_score import curves, line, summary
 
 # why the numbers look as they do (facts of the methods, not of one run)
 NOTES = {
@@ -306,10 +306,62 @@ def problem_section(records, pid, meta, s, note=None):
     return out + (["", note] if note else [])
 
 
+def curves_text(records, problems):
+    """Lines of markdown: per problem and peer, whether beamfx's error-against-whole-run-time
+    curve lies below the peer's over the errors both reach (:func:`.peers_score.curves`), and
+    where not, at which errors and by how much."""
+    lines = [
+        "",
+        (
+            "Error against whole-run time over the whole range of errors both reach (each "
+            "curve: the least whole run to reach an error ≤ x; compared at every setting's "
+            "error from the larger of the two best errors up):"
+        ),
+        "",
+    ]
+    for pid in problems:
+        for name, c in curves(records, pid).items():
+            head = f"- **{pid}** against {name} (errors ≥ {c['from']:.1e}): "
+            if not c["behind"]:
+                lines.append(head + "beamfx's curve lies below.")
+                continue
+            worst = max(c["behind"], key=lambda x: x[1] / x[2])
+            errors = [e for e, _, _ in c["behind"]]
+            lines.append(
+                head + f"beamfx behind at {len(errors)} of the steps, errors "
+                f"{min(errors):.1e} to {max(errors):.1e}; at most {worst[1] / worst[2]:.3g} x "
+                f"the time (at {worst[0]:.1e}: {_g(worst[1])} s against {_g(worst[2])} s)."
+                + _floor_text(c, worst)
+            )
+    return lines
+
+
+def _floor_text(c, worst):
+    """Why, where beamfx's time there is that of its cheapest run on the problem: what that
+    run spends its time on (the solve's share of it)."""
+    fx = c["floor"]
+    if worst[1] > 1.5 * fx["whole_s"]:
+        return ""
+    solve = fx.get("wall_s") or 0.0
+    if solve < 0.25 * fx["whole_s"]:
+        return (
+            f" There beamfx's time is that of its cheapest run ({fx['setting']}, "
+            f"{_g(fx['whole_s'])} s, of which the solve {_g(solve)} s): the fixed costs of a "
+            "run (model build, JIT look-ups, probes, reactions, frames and results.json), "
+            "not its discretisation."
+        )
+    return (
+        f" There beamfx's time is that of its cheapest run ({fx['setting']}, "
+        f"{_g(fx['whole_s'])} s, of which the solve {_g(solve)} s; the rest is the work of "
+        "each step outside Newton and the output)."
+    )
+
+
 def markdown(records, problems, notes=None):
     """The report: the summary table (whole runs to the target per code), by how much beamfx
     is behind where it is, then per problem the full table, its plot and its note."""
     lines = ["# beamfx beside its peers", "", INTRO, "", *summary_table(records, problems)]
+    lines += curves_text(records, problems)
     for pid, meta in problems.items():
         note = (notes or {}).get(pid)
         lines += problem_section(records, pid, meta, summary(records, pid), note)

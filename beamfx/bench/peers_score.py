@@ -95,3 +95,30 @@ def summary(records, problem):
     fx = at_target([r for r in rows if r["code"] == "beamfx"], target)
     out["beamfx_at_target"] = fx
     return out
+
+
+def curves(records, problem):
+    """The curve of beamfx's error against whole-run time beside each peer's, over the errors
+    both reach: ``{peer line: {"from": the least error both reach, "behind": [(error, beamfx
+    s, peer s)], "floor": the record of beamfx's least whole run on the problem}}``. A curve is the least whole-run time to reach an error ≤ x (a step function
+    of x); two of them are compared at every step of either (every setting's error) from the
+    larger of their best errors up, which is where they can cross. ``behind`` lists the
+    errors at which beamfx's time is the larger (empty: beamfx's curve lies below)."""
+    rows = [
+        r
+        for r in records
+        if r["problem"] == problem and r.get("error") is not None and r.get("whole_s") is not None
+    ]
+    fx = [r for r in rows if r["code"] == "beamfx"]
+    groups = {}
+    for r in rows:
+        if r["code"] != "beamfx":
+            groups.setdefault(line(r), []).append(r)
+    out = {}
+    for name, group in groups.items() if fx else ():
+        lo = max(min(r["error"] for r in fx), min(r["error"] for r in group))
+        steps = sorted({r["error"] for r in fx + group if r["error"] >= lo})
+        pairs = [(e, time_to(fx, e), time_to(group, e)) for e in steps]
+        behind = [(e, b, p) for e, b, p in pairs if b > p]
+        out[name] = {"from": lo, "behind": behind, "floor": min(fx, key=lambda r: r["whole_s"])}
+    return out

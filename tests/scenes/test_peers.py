@@ -155,3 +155,28 @@ def test_stack_costs_of_a_rollup_setting():
     costs = stack_costs(all_cases()["rollup_0.5"], (1, 1), repeats=1)
     assert set(costs) == {"mesh", "space", "forms", "expression", "frame"}
     assert all(0 < v < 5.0 for v in costs.values())
+
+
+def test_curves_compare_every_step_of_either_over_the_errors_both_reach():
+    """beamfx's error-against-whole-time curve against a peer's (peers_score.curves): behind
+    where the peer reaches an error sooner, from the larger best error up, and the report says
+    at which errors and by how much."""
+    from beamfx.bench.peers_score import curves
+
+    recs = [
+        _rec("beamfx", "coarse", 0.5, 1e-2),
+        _rec("beamfx", "fine", 1.0, 1e-6),
+        _rec("Exudyn", "8", 0.2, 5e-3, element="GE"),  # sooner than beamfx's 0.5 at 5e-3
+        _rec("Exudyn", "64", 2.0, 1e-4, element="GE"),  # later than beamfx's 1.0 at 1e-4
+        _rec("Exudyn", "512", 9.0, 1e-7, element="GE"),  # beyond beamfx's best error: not compared
+    ]
+    c = curves(recs, "p")["Exudyn (GE)"]
+    assert c["from"] == 1e-6
+    # 5e-3: beamfx needs its fine run (1.0 s); 1e-2: its coarse run (0.5 s), still later
+    assert c["behind"] == [(5e-3, 1.0, 0.2), (1e-2, 0.5, 0.2)]
+    assert c["floor"]["setting"] == "coarse"
+    recs[2]["whole_s"] = 1.5  # now beamfx's fine run is sooner at 5e-3 as well
+    assert curves(recs, "p")["Exudyn (GE)"]["behind"] == []
+    recs[2]["whole_s"] = 0.2
+    md = peers.markdown(recs, {"p": {"title": "fake", "beamfx_case": "c"}})
+    assert "beamfx behind at 2 of the steps, errors 5.0e-03 to 1.0e-02; at most 5 x" in md
