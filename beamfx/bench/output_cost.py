@@ -96,6 +96,12 @@ except ImportError:  # before the frame writer: the writers the runner called
     for cls in (io.PvdSeries, io.XdmfSeries, surface.SurfaceSeries):
         wrap(cls, "add", "output")
 wrap(io, "evaluate_points", "probes")
+try:  # a transient's probes, kept raw per step and made into rows per block
+    import beamfx.io.probe_blocks as blocks
+    wrap(blocks.ProbeBlocks, "record", "probes")
+    wrap(blocks.ProbeBlocks, "drain", "probes")
+except ImportError:  # (before the blocks: evaluate_points at every step)
+    pass
 wrap(snes.NewtonSolver, "solve", "newton")
 
 @atexit.register
