@@ -22,8 +22,10 @@ from pathlib import Path
 
 #: the distributions whose version the stand-in answers, and their top-level package
 OWN_VERSION = {"fenics-ufl": "ufl", "fenics-ffcx": "ffcx"}
-#: environment variables that OpenMPI's launcher (mpirun, PRRTE/PMIx) sets in each rank
-LAUNCHED = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "OMPI_MCA_ess")
+#: environment variables that a launcher sets in each rank: OpenMPI's mpirun (PRRTE/PMIx),
+#: Slurm's srun (PMI-2 or PMIx; SLURM_PROCID also in a batch script's own step, where asking
+#: for nothing only costs the faster start)
+LAUNCHED = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "OMPI_MCA_ess", "PMI_RANK", "SLURM_PROCID")
 
 
 def mpi_singleton(env=os.environ):

@@ -8,7 +8,8 @@ from beamfx import startup
 def test_a_singleton_asks_for_ob1_and_mpirun_or_the_user_keep_theirs():
     env = {}
     assert startup.mpi_singleton(env) and env == {"OMPI_MCA_pml": "ob1"}
-    for launched in ({"OMPI_COMM_WORLD_SIZE": "2"}, {"PMIX_RANK": "0"}, {"OMPI_MCA_pml": "ucx"}):
+    launches = ({"OMPI_COMM_WORLD_SIZE": "2"}, {"PMIX_RANK": "0"}, {"PMI_RANK": "1"})
+    for launched in (*launches, {"SLURM_PROCID": "0"}, {"OMPI_MCA_pml": "ucx"}):
         env = dict(launched)
         assert not startup.mpi_singleton(env) and env == launched
 
