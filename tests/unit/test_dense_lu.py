@@ -11,7 +11,7 @@ from beamfx.analyses.static import solve_static
 from beamfx.bench import all_cases
 from beamfx.bench.run import _model_of
 from beamfx.bench.scenes import case_scene
-from beamfx.solvers import NewtonSolver
+from beamfx.solvers import NewtonSolver, SolveFailed
 from beamfx.solvers.assembly import assemble_tangent
 from beamfx.solvers.options import DENSE_LIMIT, use_dense
 
@@ -109,5 +109,27 @@ def test_linear_solver_named(options):
     try:
         dense = "pc_type" not in options
         assert (solver.linear_solver == DENSE) is dense and (solver.P is not None) is dense
+    finally:
+        solver.destroy()
+
+
+def test_zero_pivot_is_a_failed_linear_solve(monkeypatch):
+    """A tangent with an exactly zero pivot (a free unknown's row and column zeroed): LAPACK's
+    getrf stops PETSc with an error, which Newton reports as a failed linear solve (as MUMPS's
+    failed factorisation), not an exception that ends the run without results.json."""
+    from beamfx.solvers import snes
+
+    def singular(A, J, bcs, *args, **kwargs):
+        assemble_tangent(A, J, bcs, *args, **kwargs)
+        A.zeroRowsColumns([A.getSize()[0] - 1], diag=0.0)
+
+    monkeypatch.setattr(snes, "assemble_tangent", singular)
+    model = _model("sm23_end_moments", 2, 3)
+    model.reset()
+    solver = NewtonSolver(model.F, model.J, model.w, model.bcs, "test_dense_pivot_")
+    try:
+        assert solver.P is not None
+        with pytest.raises(SolveFailed, match="cause: linear solve"):
+            solve_static(model, steps=1, solver=solver)
     finally:
         solver.destroy()
