@@ -149,9 +149,14 @@ class History:
         csv = (self.row_format * len(rows)).format(*numbers)
         return csv, "".join(formats) % tuple(values)
 
-    def close(self):
-        """Write the rows kept and close the probe files (rank 0)."""
-        self.flush()
+    def close(self, gather=True):
+        """Write the rows kept and close the probe files (rank 0). Collective, unless
+        ``gather`` is False (after an error that may be one rank's: with several ranks the
+        rows kept since the last block are then lost, as a killed process's)."""
+        if gather or self.comm.size == 1:
+            self.flush()
+        else:
+            self.blocks.count, self.rows = 0, []
         for f in self.files or ():
             f.close()
         self.files = None

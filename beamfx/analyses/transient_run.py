@@ -257,6 +257,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
             seconds["frames"] += _now() - t2
 
     bar, progress = _progress(model.comm, settings.t_end)
+    collective = False  # whether the history may gather when it closes
     try:
         with deferred():  # a signal stops the march at a step, with a checkpoint
             result = solve_transient(
@@ -270,14 +271,16 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
                 saved=saved,
                 reactions=series,
             )
+        collective = True
     except TransientFailed:  # collective; the model holds the last accepted state again
+        collective = True
         history.flush()  # the rows kept, and the rotations tracked up to that state
         ctx.probe_values(model)  # its full values, for results.json
         raise
-    finally:
+    finally:  # another error may be one rank's: nothing collective then (no hang)
         bar.close()
         t0 = _now()
-        history.close()
+        history.close(gather=collective)
         seconds["probes"] += _now() - t0
         series.close()
         seconds["reactions"] += series.seconds
