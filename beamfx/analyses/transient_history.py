@@ -119,11 +119,11 @@ class History:
         table = self.blocks.drain()
         if self.files is None:
             return
-        if self.rows:
-            csv, jsonl = self._block(self.rows, table[:, self.columns])
+        rows, self.rows = self.rows, []  # (taken with their table: a failed write loses both)
+        if rows:
+            csv, jsonl = self._block(rows, table[:, self.columns])
             self.files[0].write(csv)
             self.files[1].write(jsonl)
-            self.rows = []
         for f in self.files:
             f.flush()
         self.flushed = time.perf_counter()
