@@ -31,11 +31,12 @@ SPIN = spun_beam(SPIN_HISTORY, 3.0, checkpoint_every=20)
 LIMIT = 240  # s: a hang would be killed here (a run takes about 10 s)
 
 
-def mpirun(cwd, *args):
-    """``mpirun -n 2 beamfx ...``: (exit status, stderr, seconds), killed after LIMIT."""
+def mpirun(cwd, *args, entry=("-m", "beamfx.cli")):
+    """``mpirun -n 2 beamfx ...`` (or ``entry``: a script): (exit status, stderr, seconds),
+    killed after LIMIT."""
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
     env["OMPI_MCA_rmaps_base_oversubscribe"] = "1"
-    command = ["mpirun", "--allow-run-as-root", "-n", "2", sys.executable, "-m", "beamfx.cli"]
+    command = ["mpirun", "--allow-run-as-root", "-n", "2", sys.executable, *entry]
     t = time.monotonic()
     run = subprocess.run(
         [*command, *args],
@@ -88,6 +89,37 @@ def test_a_failure_on_rank_1_alone_aborts_the_job(tmp_path):
     assert code == 2, err
     assert "Is a directory" in err and "(rank 1; stopping all ranks)" in err
     print(f"rank-1 failure: job ended in {seconds:.1f} s")
+
+
+#: ``beamfx`` whose rank 0 cannot write its third row of reactions.csv (a full disk)
+FULL_DISK = """import sys
+from mpi4py import MPI
+from beamfx.io import reaction_files
+write, rows = reaction_files.ReactionCsv.write, [0]
+def failing(self, row):
+    rows[0] += 1
+    if MPI.COMM_WORLD.rank == 0 and rows[0] == 3:
+        raise OSError(28, "No space left on device (test)")
+    return write(self, row)
+reaction_files.ReactionCsv.write = failing
+from beamfx.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_a_write_error_on_rank_0_with_probe_rows_kept_aborts_the_job(tmp_path):
+    """Rank 0 fails to write reactions.csv between frames, while both ranks keep probe rows
+    for the next block: the history must not gather them from a rank that went on (it hung
+    once), the job ends with rank 0's message."""
+    output = '[output]\nevery = 10\nreaction_rows = "steps"\n'
+    (tmp_path / "spin.toml").write_text(spun_beam("0.5 * t", 0.4, dt=0.02) + output)
+    (tmp_path / "full_disk.py").write_text(FULL_DISK)
+    code, err, seconds = mpirun(
+        tmp_path, "run", "spin.toml", "--out", "out", entry=("full_disk.py",)
+    )
+    assert code == 2, err
+    assert "No space left on device (test)" in err and "(rank 0; stopping all ranks)" in err
+    print(f"rank-0 write failure: job ended in {seconds:.1f} s")
 
 
 @pytest.mark.slow
