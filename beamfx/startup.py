@@ -2,11 +2,13 @@
 
 Two fixed costs of every process, measured on the 2-core Debian 12 machine:
 
-- **OpenMPI's start** (``from mpi4py import MPI``) takes 0.39 s, 0.19 s of it choosing a
-  point-to-point layer: the default probes the network ones (UCX, OFI, PSM2). A process not
-  launched by ``mpirun`` is a singleton, one rank with nobody to talk to, so
-  :func:`mpi_singleton` asks for OpenMPI's plain ``ob1`` layer there (0.19 s in all). Under
-  ``mpirun``, or with the user's own ``OMPI_MCA_pml``, nothing is changed.
+- **OpenMPI's start** (``from mpi4py import MPI``) takes 0.39 s: 0.2 s of it choosing a
+  point-to-point layer (the default probes the network ones: UCX, OFI, PSM2), 0.12 s starting
+  a support daemon (``orted``) that only ``MPI_Comm_spawn`` would use. A process not launched
+  by ``mpirun`` is a singleton, one rank with nobody to talk to and nothing to spawn (beamfx
+  never spawns), so :func:`mpi_singleton` asks for OpenMPI's plain ``ob1`` layer and no
+  daemon (``ess_singleton_isolated``) there: 0.06 s in all. Under ``mpirun`` nothing is
+  changed, and neither is a setting the user made.
 - **pkg_resources** (setuptools, ~0.1 s: it scans every installed distribution) is imported
   by UFL 2022.2 and FFCx 0.5 only to read their own version. :func:`light_versions` puts a
   stand-in in its place that reads those two versions from their ``.dist-info`` and loads the
@@ -28,13 +30,19 @@ OWN_VERSION = {"fenics-ufl": "ufl", "fenics-ffcx": "ffcx"}
 LAUNCHED = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "OMPI_MCA_ess", "PMI_RANK", "SLURM_PROCID")
 
 
+#: what a singleton asks of OpenMPI (each unless the user set it): the ``ob1``
+#: point-to-point layer, and no support daemon (it serves only MPI_Comm_spawn)
+SINGLETON = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_ess_singleton_isolated": "1"}
+
+
 def mpi_singleton(env=os.environ):
-    """Ask OpenMPI for its ``ob1`` point-to-point layer (``OMPI_MCA_pml``) in a process not
-    started by ``mpirun`` and without a choice of the user's; True if it was set."""
-    if any(k in env for k in LAUNCHED) or "OMPI_MCA_pml" in env:
+    """Set :data:`SINGLETON`'s variables the user has not set in a process not started by
+    ``mpirun``; True if any was set."""
+    if any(k in env for k in LAUNCHED):
         return False
-    env["OMPI_MCA_pml"] = "ob1"
-    return True
+    unset = {k: v for k, v in SINGLETON.items() if k not in env}
+    env.update(unset)
+    return bool(unset)
 
 
 def dist_info_version(name, package):

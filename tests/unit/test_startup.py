@@ -5,13 +5,46 @@ import sys
 from beamfx import startup
 
 
-def test_a_singleton_asks_for_ob1_and_mpirun_or_the_user_keep_theirs():
+def test_a_singleton_asks_for_ob1_and_no_daemon_and_mpirun_or_the_user_keep_theirs():
     env = {}
-    assert startup.mpi_singleton(env) and env == {"OMPI_MCA_pml": "ob1"}
+    assert startup.mpi_singleton(env)
+    assert env == {"OMPI_MCA_pml": "ob1", "OMPI_MCA_ess_singleton_isolated": "1"}
     launches = ({"OMPI_COMM_WORLD_SIZE": "2"}, {"PMIX_RANK": "0"}, {"PMI_RANK": "1"})
-    for launched in (*launches, {"SLURM_PROCID": "0"}, {"OMPI_MCA_pml": "ucx"}):
+    for launched in (*launches, {"SLURM_PROCID": "0"}):
         env = dict(launched)
         assert not startup.mpi_singleton(env) and env == launched
+    env = {"OMPI_MCA_pml": "ucx"}  # the user's choice kept, the other still asked for
+    assert startup.mpi_singleton(env)
+    assert env == {"OMPI_MCA_pml": "ucx", "OMPI_MCA_ess_singleton_isolated": "1"}
+    mine = {"OMPI_MCA_pml": "ucx", "OMPI_MCA_ess_singleton_isolated": "0"}
+    env = dict(mine)
+    assert not startup.mpi_singleton(env) and env == mine
+
+
+def test_an_isolated_singleton_runs_mpi_and_io(tmp_path):
+    """A singleton without OpenMPI's support daemon still does what a run does: collectives,
+    and MPI-IO through HDF5 (the XDMF output)."""
+    import os
+    import subprocess
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    startup.mpi_singleton(env)
+    code = (
+        "from mpi4py import MPI; import dolfinx.io, dolfinx.mesh; c = MPI.COMM_WORLD; "
+        "m = dolfinx.mesh.create_unit_interval(c, 4); "
+        f"f = dolfinx.io.XDMFFile(c, {str(tmp_path / 'm.xdmf')!r}, 'w'); f.write_mesh(m); "
+        "f.close(); print(c.size, c.allreduce(2))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        check=False,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["1", "2"] and (tmp_path / "m.h5").stat().st_size > 0
 
 
 def test_ufl_and_ffcx_versions_are_read_as_pkg_resources_reads_them(monkeypatch):
