@@ -242,6 +242,10 @@ class NewtonSolver:
         t = time.perf_counter()
         self.w.vector.copy(self.x)
         code = self._run_snes()
+        if code == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
+            # the failed factorisation is not used again: MUMPS would stop the next solve
+            # (a step's retry) with INFOG(1) = -3; the reason is the same on every rank
+            self.snes.getKSP().getPC().reset()
         self.x.copy(self.w.vector)
         self.w.x.scatter_forward()
         if code == PETSc.SNES.ConvergedReason.CONVERGED_ITS and self._residuals:

@@ -133,3 +133,43 @@ def test_zero_pivot_is_a_failed_linear_solve(monkeypatch):
             solve_static(model, steps=1, solver=solver)
     finally:
         solver.destroy()
+
+
+@pytest.mark.parametrize("options", [{"pc_type": "lu"}, {}], ids=["mumps", "dense"])
+def test_a_retry_after_a_failed_factorisation_factorises_afresh(monkeypatch, options):
+    """A step whose tangent cannot be factored is retried with a smaller step; that retry
+    factorises anew (MUMPS stopped it with INFOG(1) = -3, exit 1 and no results.json): a
+    tangent singular only at the first attempt gives the solution of a run without it, one
+    singular at every attempt a failed solve with its cause."""
+    from beamfx.solvers import snes
+
+    calls = []
+
+    def singular(first_only):
+        def tangent(A, J, bcs, *args, **kwargs):
+            assemble_tangent(A, J, bcs, *args, **kwargs)
+            calls.append(1)
+            if not first_only or len(calls) == 1:
+                A.zeroRowsColumns([A.getSize()[0] - 1], diag=0.0)
+
+        return tangent
+
+    def run(prefix):
+        model = _model("sm23_end_moments", 2, 3)
+        model.reset()
+        solver = NewtonSolver(model.F, model.J, model.w, model.bcs, prefix, options)
+        try:
+            solve_static(model, steps=1, solver=solver)
+        finally:
+            solver.destroy()
+        return model.w.x.array.copy()
+
+    expected = run("test_retry_plain_")
+    monkeypatch.setattr(snes, "assemble_tangent", singular(first_only=True))
+    got = run("test_retry_once_")
+    assert len(calls) > 1  # the singular attempt and the retries that followed
+    scale = np.abs(expected).max()
+    assert np.abs(got - expected).max() <= 1e-8 * scale  # the Newton tolerance, not a bit match
+    monkeypatch.setattr(snes, "assemble_tangent", singular(first_only=False))
+    with pytest.raises(SolveFailed, match="cause: linear solve"):
+        run("test_retry_always_")
