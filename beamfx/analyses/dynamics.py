@@ -27,6 +27,10 @@ from .predictor import AccelerationTrend
 from .section_fields import section_kinetic_energy
 from .strain_rates import StrainHistory, bdf2_weights
 
+#: the names of the time-stepping state in :meth:`Dynamics.state` (and a checkpoint), in the
+#: order of ``Dynamics.state_values``
+STATE_NAMES = ("q_n", "v_n", "a_n", "qdd_n")
+
 
 def _trend(settings, size, owned, comm):
     """The accelerations' history for Newton's starting point (:mod:`.predictor`), for the
@@ -236,7 +240,7 @@ class Dynamics:
     def state(self):
         """Copies of the time-stepping state (q, v, a, q̈ at t_n and the predictor's history),
         for a checkpoint."""
-        arrays = {k: getattr(self, k).x.array.copy() for k in ("q_n", "v_n", "a_n", "qdd_n")}
+        arrays = {k: a.copy() for k, a in zip(STATE_NAMES, self.state_values)}
         if self.trend:
             arrays |= self.trend.state()
         return arrays | (self.strain_history.state() if self.strain_history else {})
@@ -245,11 +249,11 @@ class Dynamics:
         """Restore the time-stepping state saved by :meth:`state`; the model's unknowns follow
         q (without the predictor's history, an older checkpoint's next step starts Newton
         with unchanged acceleration)."""
-        for k in ("q_n", "v_n", "a_n", "qdd_n"):
-            getattr(self, k).x.array[:] = arrays[k]
+        for k, a in zip(STATE_NAMES, self.state_values):  # (the Functions' arrays, kept)
+            a[:] = arrays[k]
         if self.trend:
             self.trend.set_state(arrays)
-        self.model.w.x.array[:] = self.q_n.x.array
+        self.w_values[:] = self.state_values[0]
         if self.strain_history:
             self.strain_history.set_state(arrays)
 

@@ -34,6 +34,7 @@ in time and start with zero acceleration (the run starts at rest, q̈ = 0).
 """
 
 from ..solvers.integrators import richardson
+from .dynamics import STATE_NAMES
 from .predictor import STATE_KEYS
 
 
@@ -60,7 +61,7 @@ class Extrapolation:
         """Newton for the step from ``t`` to t + h of the state the Dynamics holds, from
         ``start`` (unknowns at t + h) if given, else from the Dynamics' predictor."""
         dyn = self.dyn
-        dyn.h.value = h
+        dyn.set_step(h)
         dyn.model.set_time(t + h)
         dyn.predict(h)
         if start is not None:
@@ -77,8 +78,8 @@ class Extrapolation:
             reports.append(self._substep(t + i * h / n, h / n, start if i == n - 1 else None))
             if not reports[-1].converged:
                 return reports, None, None
-            if i == n - 1:
-                self.balance.reactions()
+            if i == n - 1:  # from Newton's last residual where it kept it (the same numbers)
+                self.balance.reactions(self.solver.residual_at_solution())
                 reaction = self.balance.reaction
             self.dyn.accept(h / n)
         return reports, self.dyn.state(), reaction
@@ -107,7 +108,7 @@ class Extrapolation:
             both = {k: richardson(coarse[k], fine[k]) for k in fine if k not in STATE_KEYS}
             self._new = {"coarse": coarse, "fine": fine}, both, richardson(r_coarse, r_fine)
             dyn.model.w.x.array[:] = both["q_n"]
-            dyn.h.value = h
+            dyn.set_step(h)
         last = reports[-1]
         return last._replace(
             converged=coarse is not None,
@@ -131,12 +132,12 @@ class Extrapolation:
     def restore(self, arrays):
         """The copies from a checkpoint's ``arrays`` (none saved: both start from the shown
         state, a restart that perturbs the h² term once)."""
-        names = [f"{c}_{k}" for c in self.COPIES for k in ("q_n", "v_n", "a_n", "qdd_n")]
+        names = [f"{c}_{k}" for c in self.COPIES for k in STATE_NAMES]
         if not all(n in arrays for n in names):
             self.copies = None
             return
         # with the predictor's history where saved (predictor.py; else order 0 once)
-        keys = ("q_n", "v_n", "a_n", "qdd_n", *STATE_KEYS)
+        keys = (*STATE_NAMES, *STATE_KEYS)
         self.copies = {
             c: {k: arrays[f"{c}_{k}"].copy() for k in keys if f"{c}_{k}" in arrays}
             for c in self.COPIES

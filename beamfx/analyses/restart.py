@@ -14,8 +14,7 @@ from ..io.checkpoint import agree, checkpoint_path, read_checkpoints, write_chec
 from ..io.fingerprint import mesh_differences, mesh_fingerprint, scene_differences
 from ..io.fingerprint import scene_fingerprint as _scene_fingerprint
 from .dofs import owned_size
-
-STATE = ("q_n", "v_n", "a_n", "qdd_n")
+from .dynamics import STATE_NAMES
 
 
 def scene_fingerprint(ctx, settings):
@@ -79,7 +78,7 @@ def _numbers(x, n=None):
 def _state_problems(header, arrays, model):
     """What in a checkpoint's contents does not fit this model (sizes and kinds)."""
     local, owned = len(model.w.x.array), owned_size(model.W)
-    for k in STATE:
+    for k in STATE_NAMES:
         if k not in arrays or arrays[k].size != local:
             yield f"state {k!r}: {arrays[k].size if k in arrays else 'missing'}, not {local} values"
     b = header["balance"]
