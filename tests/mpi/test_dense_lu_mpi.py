@@ -40,3 +40,28 @@ def test_ranks_keep_mumps_serial_uses_dense():
     # both within the residual test (1e-10 of the load scale) of the same state; the tangent
     # of this unit cantilever maps that to ~1e-12 in position (serial: dense vs MUMPS 1e-16)
     assert np.abs(tip - serial_tip).max() < 1e-10
+
+
+@pytest.mark.mpi
+def test_ranks_retry_a_step_after_a_failed_factorisation(monkeypatch):
+    """On every rank alike: a tangent MUMPS cannot factor at the first attempt (the last
+    unknown's row and column zeroed, on the rank that owns it) is a failed linear solve, the
+    step's retry factorises afresh and converges to the answer of a run without it."""
+    from beamfx.solvers import snes
+    from beamfx.solvers.assembly import assemble_tangent
+
+    calls = []
+
+    def once_singular(A, J, bcs, *args, **kwargs):
+        assemble_tangent(A, J, bcs, *args, **kwargs)
+        calls.append(1)
+        if len(calls) == 1:
+            A.zeroRowsColumns([A.getSize()[0] - 1], diag=0.0)
+
+    _, plain, tip = _solve(MPI.COMM_WORLD)
+    monkeypatch.setattr(snes, "assemble_tangent", once_singular)
+    _, retried, retried_tip = _solve(MPI.COMM_WORLD)
+    assert len(calls) > 1
+    assert retried.steps[0].cutbacks == 1 and plain.steps[0].cutbacks == 0
+    scale = np.abs(tip).max()
+    assert np.abs(retried_tip - tip).max() <= 1e-8 * scale
