@@ -114,6 +114,9 @@ def run_scene(
             return run_sweep(scene, out_dir, run_scene, log=log, png=png, comm=comm)
     out = _prepare(Path(out_dir or scene.output_dir), scene, comm, out_dir is None)
     log(f"beamfx: {path} -> {out}/")
+    if restart and not analysis(scene.analysis).restart:
+        log(f"note: a {scene.analysis} analysis has no checkpoint to go on from: a fresh run")
+        restart = False
     with claim(out, comm, path, restart, log):  # locked, an earlier run's files removed
         linear_solvers(reset=True)  # those of this run only
         scene, refinement = _refine(scene, comm, log)

@@ -26,6 +26,8 @@ class Analysis(NamedTuple):
             problem (False where the analysis has out-of-plane modes).
         linear: the analysis uses linear kinematics whatever ``[model] kinematics`` says.
         doc: one line for the docs and ``beamfx check``.
+        restart: ``beamfx run --restart`` goes on from the run's checkpoint (else a restart
+            is a fresh run, and the log says so).
     """
 
     name: str
@@ -34,6 +36,7 @@ class Analysis(NamedTuple):
     plane: bool = True
     linear: bool = False
     doc: str = ""
+    restart: bool = False
 
 
 @cache

@@ -186,6 +186,8 @@ def _start(model, settings, ctx):
     from .restart import load_restart
 
     saved = load_restart(ctx, settings, model) if ctx.restart else None
+    if ctx.restart and ctx.comm.rank == 0:  # accepted: the earlier run's results go
+        (ctx.folder / "results.json").unlink(missing_ok=True)
     if ctx.restart and saved is None:
         ctx.log("note: no checkpoint for this number of ranks; starting from t = 0")
     if saved is None and settings.start == "static":
@@ -307,4 +309,4 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     )
 
 
-ANALYSES = (Analysis("transient", Settings, run, doc="time history: dynamics"),)
+ANALYSES = (Analysis("transient", Settings, run, doc="time history: dynamics", restart=True),)

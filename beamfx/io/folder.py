@@ -182,7 +182,8 @@ def release(path):
 
 def clear_earlier_run(folder, restart):
     """Remove what an earlier run wrote in ``folder`` (only names beamfx writes, listed by
-    :data:`RUN_FILES`); on a restart only its ``results.json``. A symbolic link with one of
+    :data:`RUN_FILES`); on a restart nothing (its ``results.json`` goes once the checkpoint
+    is accepted: a refused restart leaves the folder as it was). A symbolic link with one of
     those names is removed in both cases (the link, not what it points to: a run never writes
     through a link, which could lead out of the folder). Frame files
     (:data:`FRAME_FILES`) are kept for the new run to overwrite in place, unless another name
@@ -200,7 +201,7 @@ def clear_earlier_run(folder, restart):
             os.unlink(entry.path)
             removed.append(entry.name)
     for entry in entries:
-        if (restart and entry.name != "results.json") or entry.name in links:
+        if restart or entry.name in links:
             continue
         if entry.is_file(follow_symlinks=False):
             st = entry.stat(follow_symlinks=False)

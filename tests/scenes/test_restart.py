@@ -137,7 +137,9 @@ def restart(folder, capsys, scene="spin.toml"):
 
 
 def test_restart_from_another_scene_is_refused_naming_the_differences(stopped, capsys):
+    """Refused before anything runs, and the folder is left as it was, results included."""
     before = (stopped / "out" / "probes.csv").read_text()
+    results = (stopped / "out" / "results.json").read_text()
     scene = SPIN.replace("EA = 2.8e7", "EA = 2.8e5").replace("dt = 0.005", "dt = 0.004")
     (stopped / "other.toml").write_text(scene.replace("t_end = 1.2", "t_end = 2.0"))
     code, err = restart(stopped, capsys, "other.toml")
@@ -147,7 +149,7 @@ def test_restart_from_another_scene_is_refused_naming_the_differences(stopped, c
     assert "analysis.dt: 0.005 in the checkpoint, 0.004 in the scene" in err
     assert "t_end" not in err  # a restart may go on to a later end time
     assert (stopped / "out" / "probes.csv").read_text() == before
-    assert not (stopped / "out" / "results.json").exists()
+    assert (stopped / "out" / "results.json").read_text() == results
 
 
 def _evil_checkpoint(path, marker):
@@ -168,6 +170,7 @@ def _evil_checkpoint(path, marker):
 def test_a_damaged_checkpoint_is_refused_and_nothing_runs(stopped, capsys, damage):
     path = stopped / "out" / "checkpoint_1ranks_0.npz"
     marker = stopped / "pwned"
+    results = (stopped / "out" / "results.json").read_text()
     if damage == "pickle":
         _evil_checkpoint(path, marker)
         expected = "pickles are refused"
@@ -192,7 +195,7 @@ def test_a_damaged_checkpoint_is_refused_and_nothing_runs(stopped, capsys, damag
     assert code == 2 and expected in err and "Traceback" not in err
     assert "out/checkpoint_1ranks_0.npz" in err  # the file named
     assert not marker.exists()
-    assert not (stopped / "out" / "results.json").exists()
+    assert (stopped / "out" / "results.json").read_text() == results  # left as it was
 
 
 def test_a_checkpoint_of_another_mesh_is_refused(stopped, capsys):
@@ -266,3 +269,44 @@ def test_a_fresh_run_removes_the_files_of_an_earlier_run(tmp_path, capsys):
     assert b"earlier" not in frame
     assert json.loads((out / "results.json").read_text())["status"] == "converged"
     assert Path(out / "probes.csv").read_text().count("\n") == 4  # header, t = 0 and 2 steps
+
+
+STATIC = """
+[material]
+E = 1.0e7
+nu = 0.3
+[[beams]]
+name = "b"
+curve = { shape = "line", start = [0, 0, 0], end = [10, 0, 0] }
+section = { type = "rectangle", h = 0.1, w = 0.1 }
+elements = 2
+degree = 2
+[[supports]]
+at = "b:start"
+fix = "all"
+[[loads]]
+at = "b:end"
+force = [0, 0, -10]
+[analysis]
+type = "static"
+steps = 2
+"""
+
+
+def test_restart_of_a_static_run_is_a_fresh_run_and_says_so(tmp_path, capsys):
+    """--restart of an analysis without checkpoints: the log says so, and the earlier run's
+    files go as on any fresh run (its frames past this run's last were left before)."""
+    scene = tmp_path / "static.toml"
+    scene.write_text(STATIC.replace("steps = 2", "steps = 4"))
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        assert main(["run", "static.toml", "--out", "out"]) == 0
+        scene.write_text(STATIC)
+        code = main(["run", "static.toml", "--out", "out", "--restart"])
+    finally:
+        os.chdir(cwd)
+    assert code == 0
+    out = capsys.readouterr()
+    assert "has no checkpoint to go on from: a fresh run" in out.out + out.err
+    assert not (tmp_path / "out" / "deformed_0004.vtu").exists()
