@@ -38,6 +38,7 @@ import ufl
 from mpi4py import MPI
 
 from ..spec import DOF_NAMES
+from .checks import model_size
 from .dofs import constrained_dofs, owned_size
 
 
@@ -58,6 +59,21 @@ class Balance(NamedTuple):
     moment: float
     applied_force: list
     applied_moment: list
+
+
+def imbalance(residual, f_scale, m_scale, reactions, length):
+    """``(|ΣF|/scale, |ΣM|/scale)`` of the sums ``residual`` (force, moment about the origin)
+    of the reactions and loads. The scales are the loads' (``f_scale`` Σ|f|, ``m_scale``
+    Σ(|x||f| + |m|)), each at least the other's over (or times) the model's ``length``: an
+    end moment alone, or a force at the origin, has no force (moment) scale of its own. With
+    no loads (the supports' motion only), the reactions' own Σ|force| and Σ|moment|; 0 where
+    every scale is zero."""
+    if f_scale == 0.0 and m_scale == 0.0:
+        f_scale = sum(float(np.linalg.norm(r.force)) for r in reactions.values())
+        m_scale = sum(float(np.linalg.norm(r.moment)) for r in reactions.values())
+    f_ref, m_ref = max(f_scale, m_scale / length), max(m_scale, f_scale * length)
+    force, moment = (float(np.linalg.norm(part)) for part in (residual[:3], residual[3:6]))
+    return (force / f_ref if f_ref > 0 else 0.0, moment / m_ref if m_ref > 0 else 0.0)
 
 
 class _Layout(NamedTuple):
@@ -167,6 +183,7 @@ class ReactionRecovery:
         from ..solvers.forms import compile_form
 
         self.model, self.layout = model, _layout(model)
+        self.length = model_size(model.spec)  # the balance's length scale
         self._F = self.b = None  # compiled at first use (a transient uses its own residual)
         self.ground = None
         if model.Pi_ground is not None:
@@ -230,13 +247,9 @@ class ReactionRecovery:
         """``({point: Reaction}, Balance)`` at the current state. Collective."""
         load = self.applied()
         out, total, [applied] = self.at_points(self.assemble(self.F), [load])
-        force, moment, f_scale, m_scale = applied[:3], applied[3:6], applied[6], applied[7]
-        balance = Balance(
-            float(np.linalg.norm(total[:3] + force) / max(f_scale, 1e-300)),
-            float(np.linalg.norm(total[3:] + moment) / max(m_scale, 1e-300)),
-            force.tolist(),
-            moment.tolist(),
-        )
+        force, moment = applied[:3], applied[3:6]
+        ratios = imbalance(total[:6] + applied[:6], applied[6], applied[7], out, self.length)
+        balance = Balance(*ratios, force.tolist(), moment.tolist())
         return out, balance
 
     def at_points(self, residual, extra=()):

@@ -41,8 +41,9 @@ import numpy as np
 
 from ..io.reaction_files import ReactionCsv, columns
 from ..physics.rotations import _norm  # np.linalg.norm's value, without its checks
+from .checks import model_size
 from .dofs import constrained_dofs, owned_size
-from .reactions import ReactionRecovery
+from .reactions import ReactionRecovery, imbalance
 
 _now = time.perf_counter
 
@@ -82,6 +83,7 @@ class TransientReactions:
         self.size = len(dyn.model.w.x.array)  # owned and ghost entries
         held = constrained_dofs(dyn.model.bcs)
         self.free[held[held < len(self.free)]] = False
+        self.length = model_size(dyn.model.spec)  # the balance's length scale
 
     def __call__(self, residual=None):
         """``({point: Reaction}, DynamicBalance)``; ``residual``: the step's residual (owned
@@ -106,9 +108,15 @@ class TransientReactions:
             np.sqrt(model.comm.allreduce(squares) if model.comm.size > 1 else squares)
         )
         fa, ma, fi, mi = applied[:3], applied[3:6], inert[:3], inert[3:6]
+        ratios = imbalance(
+            total[:6] + applied[:6] - inert[:6],
+            applied[6] + inert[6],
+            applied[7] + inert[7],
+            reactions,
+            self.length,
+        )
         balance = DynamicBalance(
-            float(_norm(total[:3] + fa - fi) / max(applied[6] + inert[6], 1e-300)),
-            float(_norm(total[3:] + ma - mi) / max(applied[7] + inert[7], 1e-300)),
+            *ratios,
             fa.tolist(),
             ma.tolist(),
             fi.tolist(),
