@@ -270,16 +270,19 @@ def _model_entry(scene, ctx):
         "stretch": kin.stretch,
         "trimming": _trimming(scene, model, condensed)[1],
         "condensed": condensed,
-        "formulation": _formulation(scene, model),
+        "formulation": _formulation(scene, model, fell_back=bool(scene.condense) and not condensed),
         **({"condensing": _condensing(ctx)} if condensed else {}),
     }
 
 
-def _formulation(scene, model):
+def _formulation(scene, model, fell_back=False):
     """The ``formulation`` entry of results.json: displacement or mixed
-    (:mod:`beamfx.analyses.mixed`), and why."""
+    (:mod:`beamfx.analyses.mixed`), and why (``fell_back``: the full model solved after the
+    condensed one failed)."""
     name = "mixed" if getattr(model, "mixed", False) else "displacement"
     why = scene.trimming.formulation if scene.trimming else ""
+    if fell_back:
+        why = "the full model's, after the statically condensed model failed"
     return {"name": name, "reason": why or "given as a model"}
 
 

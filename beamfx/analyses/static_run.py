@@ -90,7 +90,15 @@ def run(model: Formulation, settings: Settings, ctx: RunContext) -> Result:
         fallback = f"the statically condensed model failed ({e})"
         ctx.log(f"model: {fallback}; solving the full model")
         model = ctx.fallback()
-        solved, path = solve(model, settings, ctx)
+        try:
+            solved, path = solve(model, settings, ctx)
+        except SolveFailed as full:  # both said: the condensed model's failure came first
+            details = {**full.details, "fallback": fallback}
+            first = getattr(e, "cause", None) or type(e).__name__
+            message = (
+                f"the statically condensed model failed first ({first}), then the full: {full}"
+            )
+            raise SolveFailed(message, full.history, full.cause, full.remedy, details) from e
     return Result(
         analysis=ctx.analysis,
         load_steps=solved.steps,

@@ -3,7 +3,10 @@
 from typing import NamedTuple
 
 from .convergence import describe, remedy
-from .snes import SolveFailed
+from .snes import DEFAULT_OPTIONS, SolveFailed
+
+#: causes whose usual remedy is a smaller load step (convergence.REMEDIES)
+STEP_CAUSES = ("divergence", "stagnation above the floor", "max iterations", "nan")
 
 
 class SavedState:
@@ -113,11 +116,31 @@ def step_load(
     return history
 
 
+def _remedy(last, sizes, steps):
+    """The remedy of the ``last`` attempt of a step tried at the load increments ``sizes``:
+    more iterations if ``[solver] snes_max_it`` stopped Newton below PETSc's default; not a
+    smaller step if the cut-backs went down to a hundredth of the first try and failed the
+    same way; else the cause's own (:func:`~beamfx.solvers.convergence.remedy`)."""
+    default = DEFAULT_OPTIONS["snes_max_it"]
+    if last.reason == "DIVERGED_MAX_IT" and last.iterations < default:
+        return (
+            f"more iterations: [solver] snes_max_it = {last.iterations} stops Newton before "
+            f"it converges (the default is {default})"
+        )
+    if last.cause in STEP_CAUSES and len(sizes) > 1 and min(sizes) <= 1e-2 * sizes[0]:
+        return (
+            f"not a smaller step: cut back to {min(sizes) / sizes[0]:.1e} of the first try, "
+            f"Newton still failed ({last.cause}); check the supports, the loads and their "
+            "units, the section constants and the [solver] options"
+        )
+    return remedy(last.cause, steps)
+
+
 def _failure(history, lam, tried, steps):
     """The :class:`SolveFailed` of a load step that cannot be cut back further: the cause and
     remedy of the last attempt, every attempt's residuals."""
     last = tried[-1][1]
-    fix = remedy(last.cause, steps)
+    fix = _remedy(last, [t - lam for t, _ in tried], steps)
     lines = "\n".join(
         f"  load factor {t:.6g}: {r.reason} ({r.cause}), |F| = "
         + ", ".join(f"{x:.3e}" for x in r.residuals)

@@ -141,6 +141,34 @@ def test_a_force_of_1e12_is_not_accepted_with_a_large_residual(tmp_path, capsys)
         assert_failed(code, results, err, results["cause"])
 
 
+def test_a_low_iteration_limit_is_named_and_the_condensed_failure_is_kept(tmp_path, capsys):
+    """[solver] snes_max_it = 1 on a load Newton needs more for: the remedy names the limit
+    (it said "steps = 4" after cut-backs to 1e-4 of the load), and a run that fell back from
+    the condensed model to the full one says both (the first failure was lost)."""
+    text = CANTILEVER.format(force=-2e5).replace('condense = "none"', 'condense = "auto"')
+    code, results, captured = run(tmp_path, text + "[solver]\nsnes_max_it = 1\n", capsys)
+    assert_failed(code, results, captured, results["cause"])
+    assert results["remedy"].startswith("more iterations: [solver] snes_max_it = 1 ")
+    assert "the statically condensed model failed first" in results["reason"]
+    assert "statically condensed model failed" in results["failure"]["fallback"]
+    assert results["model"]["condensed"] is False
+    assert (
+        "after the statically condensed model failed" in results["model"]["formulation"]["reason"]
+    )
+
+
+def test_a_step_cut_back_without_help_is_not_told_to_take_smaller_steps():
+    """A failure that cut-backs to a hundredth of the first try did not cure gets no "smaller
+    load steps" remedy; one with few cut-backs keeps it."""
+    from beamfx.solvers.snes import SolveReport
+    from beamfx.solvers.stepping import _remedy
+
+    report = SolveReport(False, "DIVERGED_DTOL", 5, (1.0, 10.0), {}, cause="divergence")
+    deep = _remedy(report, [1.0 / 2**k for k in range(10)], 40)
+    assert deep.startswith("not a smaller step") and "steps =" not in deep
+    assert "steps = 40" in _remedy(report, [1.0, 0.5], 40)
+
+
 def test_an_eigen_solve_with_fewer_pairs_than_asked_is_reported_not_raised(tmp_path, capsys):
     """50 modes of a 2-element cantilever (24 free unknowns): a report with the pairs found,
     exit 3, no traceback (it raised RuntimeError, exit 1)."""
