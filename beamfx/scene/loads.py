@@ -108,13 +108,13 @@ def _point_mass(t):
 
 
 def _fix(t):
+    allowed = f"allowed: {list(FIX_WORDS)} or a list of {list(DOF_NAMES)}"
+    if t.has("fix") and not isinstance(t.data["fix"], (str, list)):
+        t.fail("fix", f"{t.data['fix']!r} is not allowed; {allowed}")
     fix = t.get("fix", (str, list))
     if isinstance(fix, str):
         if fix not in FIX_WORDS:
-            t.fail(
-                "fix",
-                f"{fix!r} is not allowed; allowed: {list(FIX_WORDS)} or a list of {list(DOF_NAMES)}",
-            )
+            t.fail("fix", f"{fix!r} is not allowed; {allowed}")
         return tuple(FIX_WORDS[fix])
     bad = [d for d in fix if d not in DOF_NAMES]
     if bad or not fix:

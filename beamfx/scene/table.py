@@ -32,7 +32,7 @@ def is_number(value):
 def number_problem(value, positive=False):
     """Why ``value`` is not a finite number (> 0 if ``positive``), or None."""
     if not isinstance(value, numbers.Real) or isinstance(value, bool):
-        return f"expected a number, got {value!r}"
+        return f"expected a number, got {_short(value)}"
     if not is_number(value):
         why = "a finite number" + (" > 0" if positive else "")
         return f"= {_short(value)}: must be {why} of magnitude at most {MAX_MAGNITUDE:.0e}"
@@ -57,8 +57,9 @@ def joined(where, message):
 
 
 def _short(value, limit=80):
-    """``repr(value)`` cut to ``limit`` characters (a hostile value may be huge)."""
-    text = repr(value)
+    """``repr(value)`` cut to ``limit`` characters (a hostile value may be huge); TOML's
+    ``true``/``false`` for booleans."""
+    text = str(value).lower() if isinstance(value, bool) else repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
@@ -75,7 +76,16 @@ class Table:
         return f"{self.file}: {self.path + '.' if self.path else ''}{key}"
 
     def fail(self, key, message):
-        """Raise a :class:`SceneError` naming ``key`` and its file."""
+        """Raise a :class:`SceneError` naming ``key`` and its file; if ``key`` is absent and
+        the table has an unread key spelled like it, that key is named instead (a missing
+        ``stiffness`` beside a ``stiffnes`` is the misspelling's fault)."""
+        if key not in self.data:
+            import difflib
+
+            unread = [k for k in self.data if k not in self.used and isinstance(k, str)]
+            near = difflib.get_close_matches(key, unread, n=1, cutoff=0.75)
+            if near:
+                raise SceneError(f"{self.where(near[0])}: unknown key; did you mean {key!r}?")
         raise SceneError(joined(self.where(key), message))
 
     def has(self, key):
@@ -106,7 +116,9 @@ class Table:
             if abs(value) > MAX_INT:
                 self.fail(key, f"= {value}: must be an integer of at most {MAX_INT:.0e}")
         elif not isinstance(value, kind):
-            self.fail(key, f"expected {_TYPE_NAMES.get(kind, kind)}, got {_short(value)}")
+            kinds = kind if isinstance(kind, tuple) else (kind,)
+            names = " or ".join(_TYPE_NAMES.get(k, getattr(k, "__name__", str(k))) for k in kinds)
+            self.fail(key, f"expected {names}, got {_short(value)}")
         if choices is not None and value not in choices:
             self.fail(key, f"{_short(value)} is not allowed; allowed: {list(choices)}")
         if positive and not value > 0:

@@ -28,6 +28,19 @@ def scene_with(edit):
             lambda d: d["beams"][0].update(elements="8"),
             ["beams[0].elements", "expected an integer"],
         ),
+        (  # a misspelt key whose table then lacks the key: the misspelling is named
+            lambda d: d.update(springs=[{"at": "bend:end", "stiffnes": [1.0, 2.0, 3.0]}]),
+            ["springs[0].stiffnes: unknown key; did you mean 'stiffness'?"],
+        ),
+        (
+            lambda d: d.update(masses=[{"at": "bend:end", "mas": 1.0}]),
+            ["masses[0].mas: unknown key; did you mean 'mass'?"],
+        ),
+        (  # the words allowed, not Python's type names
+            lambda d: d["supports"][0].update(fix=6),
+            ["supports[0].fix", "6 is not allowed; allowed: ['all', 'clamped', 'pinned']"],
+        ),
+        (lambda d: d["material"].update(E=True), ["material.E", "got true"]),
         (
             lambda d: d["beams"][0]["curve"].update(shape="circle"),
             ["beams[0].curve.shape", "allowed", "arc"],
