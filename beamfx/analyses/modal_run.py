@@ -63,6 +63,12 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes
 
     ctx.require_mass(model, "modal")
+    if settings.modes > model.unknowns():  # bad input, said before the (pre-stress) solve
+        raise ValueError(
+            f"{ctx.file}: analysis.modes = {settings.modes}: the model has "
+            f"{model.unknowns()} unknowns, so at most that many modes (fewer: less its "
+            "supported ones)"
+        )
     spec, steps = ctx.spec, ()
     if settings.prestress and _loaded(spec):
         steps = prestress(

@@ -60,7 +60,7 @@ fix = "all"
 
 [analysis]
 type = "modal"
-modes = 50
+modes = 30
 """
 
 ROTATING = """
@@ -170,14 +170,28 @@ def test_a_step_cut_back_without_help_is_not_told_to_take_smaller_steps():
 
 
 def test_an_eigen_solve_with_fewer_pairs_than_asked_is_reported_not_raised(tmp_path, capsys):
-    """50 modes of a 2-element cantilever (24 free unknowns): a report with the pairs found,
+    """30 modes of a 2-element cantilever (35 unknowns, 24 free): a report with the pairs found,
     exit 3, no traceback (it raised RuntimeError, exit 1)."""
     code, results, captured = run(tmp_path, MODAL, capsys)
     assert_failed(code, results, captured, "eigen solve")
     failure = results["failure"]
-    assert failure["requested"] == 50 and 0 < failure["converged"] < 50
+    assert failure["requested"] == 30 and 0 < failure["converged"] < 30
     assert len(failure["eigenvalues"]) == failure["converged"]
     assert "Traceback" not in captured.err
+
+
+def test_more_modes_than_unknowns_is_bad_input_before_the_solve(tmp_path, capsys):
+    """5000 modes of a 35-unknown model: exit 2 naming the key and the count (it failed as a
+    numerical eigen solve, exit 3)."""
+    folder = Path(MPI.COMM_WORLD.bcast(str(tmp_path)))
+    if MPI.COMM_WORLD.rank == 0:
+        (folder / "scene.toml").write_text(MODAL.replace("modes = 30", "modes = 5000"))
+    MPI.COMM_WORLD.barrier()
+    code = main(["run", str(folder / "scene.toml"), "--out", str(folder / "out")])
+    err = capsys.readouterr().err
+    assert code == 2 and not (folder / "out" / "results.json").exists()
+    if MPI.COMM_WORLD.rank == 0:
+        assert "analysis.modes = 5000: the model has 35 unknowns" in err
 
 
 def test_a_numerical_newton_failure_of_a_rotating_run_is_failed_not_stopped(tmp_path, capsys):
