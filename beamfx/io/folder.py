@@ -78,10 +78,23 @@ def check_output_dir(path, scene_file=None):
             f"{where}{str(path)!r} is in the system folder {system}: beamfx writes no results "
             f"under {', '.join(('/',) + SYSTEM_FOLDERS)}"
         )
-    if scene_file is None or not os.path.exists(scene_file):
+    if scene_file is None:
+        return
+    if str(path).startswith("~"):
+        raise FolderError(
+            f"{where}{str(path)!r}: '~' is not your home folder here (nothing in a scene is "
+            "expanded); give a folder relative to the current one, or 'beamfx run --out'"
+        )
+    if not os.path.exists(scene_file):
         return
     roots = [Path.cwd().resolve(), Path(scene_file).resolve().parent]
-    if not any(resolved == r or r in resolved.parents for r in roots):
+    if resolved in roots:  # a fresh run would clear beamfx's file names there
+        raise FolderError(
+            f"{where}{str(path)!r} is the {'current' if resolved == roots[0] else 'scene'} "
+            "folder itself: give a folder of its own below it (e.g. 'results'), or name it "
+            "with 'beamfx run --out'"
+        )
+    if not any(r in resolved.parents for r in roots):
         raise FolderError(
             f"{where}{str(path)!r} ({resolved}) is outside the scene's folder ({roots[1]}) "
             f"and the current folder ({roots[0]}): a scene may only write under those; "

@@ -54,6 +54,7 @@ def write_json_atomic(path, obj, comm=MPI.COMM_WORLD, levels=2):
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".json", dir=folder)
     try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp's 0600 -> what open() gives the others
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             # one write of the whole text (json.dump writes each of its many pieces)
             f.write(dumps(obj, levels) + "\n")
@@ -62,6 +63,13 @@ def write_json_atomic(path, obj, comm=MPI.COMM_WORLD, levels=2):
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
+
+
+def _umask():
+    """The process's file mode creation mask (read by setting it, then put back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def check_writable(folder, comm=MPI.COMM_WORLD):

@@ -57,6 +57,12 @@ def test_a_scene_writes_under_its_folder_or_the_current_one(tmp_path, monkeypatc
     with pytest.raises(FolderError, match=r"output\.dir: '\.\./elsewhere'.*outside.*--out"):
         check_output_dir("../elsewhere", scene)
     check_output_dir("../elsewhere")  # named on the command line: allowed
+    for itself in (".", "", str(tmp_path / "scenes"), "../scenes/."):  # a folder of its own
+        with pytest.raises(FolderError, match="folder itself: give a folder of its own"):
+            check_output_dir(itself, scene)
+    with pytest.raises(FolderError, match="'~' is not your home folder"):  # nor expanded
+        check_output_dir("~/results", scene)
+    check_output_dir(".")  # on the command line: the user's own choice
 
 
 def test_the_cli_refuses_a_scene_that_writes_into_etc(tmp_path, capsys, monkeypatch):

@@ -356,6 +356,11 @@ def test_json_atomic_and_writable(tmp_path):
         with open(path) as fh:
             assert json.load(fh) == {"a": [0, 1, 2], "b": 2.5, "c": {"d": [[1.0, 0.0], [0.0, 1.0]]}}
         assert os.listdir(os.path.dirname(path)) == ["result.json"]  # no temporary left
+        with open(os.path.join(folder, "plain"), "w") as fh:  # as any file open() makes
+            fh.write("x")
+        assert (
+            os.stat(path).st_mode & 0o777 == os.stat(os.path.join(folder, "plain")).st_mode & 0o777
+        )
         with open(os.path.join(folder, "a_file"), "w") as fh:
             fh.write("x")
     bad = os.path.join(folder, "a_file", "results")
