@@ -14,6 +14,9 @@ Two fixed costs of every process, measured on the 2-core Debian 12 machine:
   stand-in in its place that reads those two versions from their ``.dist-info`` and loads the
   real module the moment anything else is asked of it.
 
+And the JIT's C builds go through Python's own ``distutils`` (:func:`quiet_compiler`), whose
+build log is silent, as under the Makefile.
+
 Only the command line does this (:func:`beamfx.cli.main`); ``import beamfx`` changes nothing.
 """
 
@@ -116,10 +119,28 @@ def light_versions():
     return True
 
 
+def quiet_compiler(env=os.environ):
+    """Python's own ``distutils`` for the JIT's C builds (``SETUPTOOLS_USE_DISTUTILS=stdlib``,
+    what the Makefile sets), unless the user chose or ``distutils`` is imported already:
+    through setuptools' copy, cffi's build logged ``running build_ext`` and every ``gcc``
+    line at INFO on the root logger, 20-30 lines on stderr per compiled scene. Its import
+    hook, installed at the interpreter's start by setuptools' ``.pth``, is taken out. True
+    if it was set."""
+    if "SETUPTOOLS_USE_DISTUTILS" in env or "distutils" in sys.modules:
+        return False
+    env["SETUPTOOLS_USE_DISTUTILS"] = "stdlib"
+    hack = sys.modules.get("_distutils_hack")
+    if hack is not None and hasattr(hack, "remove_shim"):
+        hack.remove_shim()
+    return True
+
+
 def prepare():
-    """Both, before anything imports mpi4py, UFL or FFCx (:func:`beamfx.cli.main`); the
+    """All three, before anything imports mpi4py, UFL, FFCx or distutils
+    (:func:`beamfx.cli.main`); the
     stand-in only while UFL or FFCx is still to be imported (a second ``main`` in one process,
     a test's, has nothing to save and would leave it in place)."""
     mpi_singleton()
+    quiet_compiler()
     if not all(package in sys.modules for package in OWN_VERSION.values()):
         light_versions()

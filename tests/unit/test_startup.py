@@ -84,3 +84,12 @@ def test_a_bench_process_imports_only_the_module_of_its_case():
     assert REGISTERED_IN["spin_up_time"] == "beamfx.bench.transient"
     assert set(REGISTERED_IN) == set(cases)
     assert all(m.startswith("beamfx.bench.") and m in sys.modules for m in REGISTERED_IN.values())
+
+
+def test_the_compiler_log_is_quieted_unless_the_user_chose(monkeypatch):
+    """SETUPTOOLS_USE_DISTUTILS=stdlib where nobody set it and distutils is still to come."""
+    monkeypatch.delitem(sys.modules, "distutils", raising=False)
+    env = {}
+    assert startup.quiet_compiler(env) and env == {"SETUPTOOLS_USE_DISTUTILS": "stdlib"}
+    mine = {"SETUPTOOLS_USE_DISTUTILS": "local"}
+    assert not startup.quiet_compiler(mine) and mine == {"SETUPTOOLS_USE_DISTUTILS": "local"}
