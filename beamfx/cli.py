@@ -6,16 +6,23 @@ import sys
 
 
 def _parser():
+    from . import __version__
+
     parser = argparse.ArgumentParser(
         prog="beamfx", description="Geometrically exact 3D beams on FEniCSx."
     )
+    parser.add_argument("--version", action="version", version=f"beamfx {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser(
         "run",
         help="solve a scene (the built-in 45-degree bend if none is given); a scene with "
         "[[sweep]] tables runs as an ensemble across the MPI ranks",
     )
-    p.add_argument("scene", nargs="?")
+    p.add_argument(
+        "scene",
+        nargs="?",
+        help="scene file (TOML, see docs/scenes.md); none: the built-in 45-degree bend",
+    )
     p.add_argument("--out", help="output folder (default: the scene's [output] dir)")
     p.add_argument(
         "--restart",
@@ -33,22 +40,42 @@ def _parser():
         help="transient: also an animated GIF of the frames (implies --png)",
     )
     p = sub.add_parser("check", help="validate a scene file without solving")
-    p.add_argument("scene")
+    p.add_argument("scene", help="scene file (TOML)")
     p = sub.add_parser("bench", help="run the benchmark cases and write a report")
     p.add_argument("cases", nargs="*", help="case ids (default: all); see --list")
-    p.add_argument("--report", help="folder for bench.json and README.md")
+    p.add_argument(
+        "--report", help="folder for bench.json and README.md (without it nothing is written)"
+    )
     p.add_argument("--list", action="store_true", help="list the case ids")
     p = sub.add_parser("warm", help="compile the kernels of common scenes into the JIT cache")
     p.add_argument("scenes", nargs="*", help="also these: files, folders, .md with toml blocks")
-    p.add_argument("--only", action="store_true", help="only these (not the default and grid)")
+    p.add_argument(
+        "--only",
+        action="store_true",
+        help="only these scenes (not the built-in scene and the grid of common cases)",
+    )
     p = sub.add_parser("solid", help="the 3D solid of a one-beam scene, compared with the beam")
-    p.add_argument("scene")
+    p.add_argument("scene", help="scene file (TOML) of one beam")
     p.add_argument("--out", help="output folder (default: <the scene's [output] dir>/solid)")
     p.add_argument("--material", help="linear, svk or neo-hookean (default: from the kinematics)")
     p.add_argument("--section-cells", type=int, default=2, help="cells across the section")
-    p.add_argument("--layers", type=int, help="cells along the centre line (default: aspect 8)")
-    p.add_argument("--cell", default="hexahedron", help="hexahedron (rectangles) or tetrahedron")
-    p.add_argument("--solver", default="auto", choices=("auto", "direct", "iterative"))
+    p.add_argument(
+        "--layers",
+        type=int,
+        help="cells along the centre line (default: cells at most 8 times longer than wide)",
+    )
+    p.add_argument(
+        "--cell",
+        default="hexahedron",
+        choices=("hexahedron", "tetrahedron"),
+        help="hexahedron (rectangular sections) or tetrahedron",
+    )
+    p.add_argument(
+        "--solver",
+        default="auto",
+        choices=("auto", "direct", "iterative"),
+        help="linear solver of the solid (auto: direct up to a size, then iterative)",
+    )
     p.add_argument(
         "--png", action="store_true", help="also a picture of the solid and the beam (pyvista)"
     )
