@@ -242,7 +242,8 @@ def _analysis(t, model, limits):
 
     entry = analyses()[t.get("type", str, "static", choices=tuple(analyses()))]
     defaults = getattr(entry.settings, "defaults", lambda model: {})(model)
-    settings = read_settings(entry.settings, t, defaults, max_count=limits.max_count)
+    settings = read_settings(entry.settings, t, defaults, done=False, max_count=limits.max_count)
+    t.done(_other_analyses(t, analyses()))
     for key, message in getattr(settings, "problems_in", lambda model: ())(model):
         t.fail(key, message)
     t_end, dt = getattr(settings, "t_end", None), getattr(settings, "dt", None)
@@ -253,6 +254,20 @@ def _analysis(t, model, limits):
             f"{limits.max_count} ([limits] max_count raises it)",
         )
     return entry, settings
+
+
+def _other_analyses(t, entries):
+    """What the first unknown key of ``[analysis]`` belongs to, if another analysis type takes
+    it (``modes`` without ``type = "modal"``): a note for :meth:`Table.done`."""
+    from dataclasses import fields
+
+    unknown = sorted(k for k in t.data if k not in t.used)
+    if not unknown:
+        return ""
+    takes = [
+        name for name, a in entries.items() if unknown[0] in {f.name for f in fields(a.settings)}
+    ]
+    return f"; {unknown[0]!r} is a key of type = {takes}" if takes else ""
 
 
 def choose_model(model, analysis, settings, plane="auto", condense="auto", formulation="auto"):

@@ -41,6 +41,10 @@ def scene_with(edit):
             ["supports[0].fix", "6 is not allowed; allowed: ['all', 'clamped', 'pinned']"],
         ),
         (lambda d: d["material"].update(E=True), ["material.E", "got true"]),
+        (  # a key of another analysis type: which ones take it
+            lambda d: d["analysis"].update(modes=4),
+            ["analysis.modes: unknown key", "'modes' is a key of type = [", "'modal'"],
+        ),
         (
             lambda d: d["beams"][0]["curve"].update(shape="circle"),
             ["beams[0].curve.shape", "allowed", "arc"],
