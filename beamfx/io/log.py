@@ -1,5 +1,6 @@
 """Rank-0 logging and a one-line progress display."""
 
+import os
 import sys
 import time
 
@@ -28,7 +29,12 @@ class Progress:
         self.total, self.label = total, label
         self.stream = stream or sys.stdout
         self.active = comm.rank == 0
-        self.tty = self.active and hasattr(self.stream, "isatty") and self.stream.isatty()
+        # under mpirun a rank's output is a pseudo-terminal even when mpirun's goes to a file:
+        # plain lines there (a redrawn line became one long line of carriage returns)
+        launched = "OMPI_COMM_WORLD_SIZE" in os.environ or comm.size > 1
+        self.tty = (
+            self.active and not launched and hasattr(self.stream, "isatty") and self.stream.isatty()
+        )
         self._width = 0
         # seconds between lines shown (None: every update); a terminal line is cheap to
         # overwrite, so it refreshes at least 5 times as often as plain lines are written
