@@ -105,7 +105,8 @@ def test_a_continuation_converges_below_the_divergence_speed_and_stops_past_it(s
 def test_a_numerical_failure_of_a_continuation_names_the_speeds_and_is_not_a_stop():
     """Newton with no preconditioner (the 'linear solve' is the identity) fails from 0 to
     100 rad/s: a numerical failure (the tangent is positive definite at the last converged
-    state, the one at 0 rad/s), whose remedy asks for speeds in between, not load steps."""
+    state, the one at 0 rad/s). Cut-backs to 1e-4 of the speed step did not help, so the
+    remedy is neither load steps nor speeds in between but the model and solver options."""
     from beamfx.analyses.rotating_checks import NoSteadyState
     from beamfx.bench._builders import CLAMP, straight
     from beamfx.physics import sections
@@ -128,5 +129,19 @@ def test_a_numerical_failure_of_a_continuation_names_the_speeds_and_is_not_a_sto
     e = caught.value
     assert not isinstance(e, NoSteadyState)
     assert e.details["speed_rad_s"] == 0.0 and "stays positive definite" in e.details["tangent"]
-    assert "more speeds between 0 and 100 rad/s" in e.remedy and "steps =" not in e.remedy
+    assert e.remedy.startswith("not a smaller step") and "[solver] options" in e.remedy
+    assert "steps =" not in e.remedy and "more speeds" not in e.remedy
     assert str(e).count(e.remedy) == 1 and "continuing the steady state from 0 to 100" in str(e)
+
+
+def test_a_continuation_failure_asks_for_speeds_where_it_would_ask_for_load_steps():
+    """The load-step remedy of a failed continuation becomes one of intermediate speeds."""
+    from beamfx.analyses.rotating_path import _explain
+    from beamfx.solvers.convergence import remedy
+    from beamfx.solvers.snes import SolveFailed
+
+    fix = remedy("divergence", 40)
+    error = SolveFailed(f"Newton failed; remedy: {fix}", (), "divergence", fix)
+    _explain(error, 0.0, 100.0)
+    assert error.remedy == "smaller load steps: more speeds between 0 and 100 rad/s in speeds_rad_s"
+    assert str(error).count(error.remedy) == 1 and "from 0 to 100 rad/s" in str(error)
