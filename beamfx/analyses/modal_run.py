@@ -83,7 +83,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
         kind = " rigid-body (0 Hz to round-off)" if i <= rigid else ""
         ctx.log(f"  mode {i}: {f:.6g} Hz ({w:.6g} rad/s){kind}")
-    m_eff = effective_masses(model, res.modes, settings.rotary_inertia)
+    m_eff = effective_masses(model, res.modes, settings.rotary_inertia, res.mass_form)
     return Result(
         analysis=ctx.analysis,
         load_steps=tuple(steps),
