@@ -3,6 +3,8 @@
 import os
 import time
 
+from . import signature
+
 JIT_PARAMS = {
     # another process (xdist worker, MPI rank, CI job) may compile the same form: wait for it
     # instead of the 10 s default (DOLFINx notes, section 9)
@@ -42,7 +44,8 @@ def remember_loaded_modules():
     lookup of a module compiled and marked ready (``<name>.c.cached``) loads its extension file
     by name (:func:`_load_ready`) without listing the folder (6 ms a module with 11 000 files,
     the listing growing with every model a user has run); anything else (not compiled, being
-    compiled by another process, another file name) goes through FFCx's lookup. Idempotent.
+    compiled by another process, another file name) goes through FFCx's lookup. The names
+    themselves are hashed by :mod:`.signature` (UFL's bytes, fewer steps). Idempotent.
     """
     from ffcx.codegeneration import jit
 
@@ -50,6 +53,7 @@ def remember_loaded_modules():
         return
     _lazy_parameter_log()
     _expression_signature_once()
+    signature.install()
     _lazy_form_constants()
     lookup, loaded = jit.get_cached_module, {}
 

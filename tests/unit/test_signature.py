@@ -1,0 +1,133 @@
+"""The expression hash data that names compiled forms (:mod:`beamfx.solvers.signature`) is
+UFL's own, byte for byte: on the forms of every kind of model a run builds (planar and
+spatial condensed, full, planar full, mixed; residual, tangent, mass, follower coupling), in
+the order a run signs them and in other orders (the digests one form leaves for the next are
+reused only where they hold), and it keeps no model alive."""
+
+import gc
+import weakref
+
+import pytest
+import ufl
+from mpi4py import MPI
+from ufl.algorithms import signature as ufl_signature
+
+from beamfx.analyses.modal import mass_ufl
+from beamfx.analyses.planar_condensed import build_model
+from beamfx.bench import all_cases
+from beamfx.solvers import signature
+from beamfx.solvers.forms import remember_loaded_modules
+
+# (case, elements, degree, condensed): planar condensed, spatial condensed with a follower
+# force, full spatial (quaternion), full planar, mixed
+MODELS = [
+    ("rollup_0.5", 2, 1, True),
+    ("sm23_end_moments", 2, 3, True),
+    ("bend45_follower", 1, 4, True),
+    ("bend45_vertical", 2, 2, False),
+    ("rollup_0.5", 2, 2, False),
+    ("sm28_free_free_timoshenko", 1, 2, False),
+    ("sm28_free_free_eigen", 2, 3, False),
+]
+
+
+def _spec(case_id, elements, degree):
+    """The model of the case's scene, as the scene builder chose it (planar where it is)."""
+    from beamfx.bench.scenes import SceneCase, setting_scene
+
+    case = all_cases()[case_id]
+    if isinstance(case, SceneCase):
+        return case.scenes(elements, degree)[0].model
+    return setting_scene(case, (elements, degree)).model
+
+
+def _forms(model):
+    """The forms of ``model`` a run compiles, in a run's order."""
+    from beamfx.analyses.model import BeamModel
+
+    forms = [model.F, model.J]
+    if isinstance(model, BeamModel):  # a full model: its mass form (modal)
+        forms.append(mass_ufl(model, "full"))
+    if getattr(model, "_followers", None):  # the follower forces' coupling forms
+        forms += [ufl.derivative(x * model.dx, model.w) for x in model.x_dot]
+    return forms
+
+
+def _ufl_own(form):
+    """The signature of ``form`` by UFL's own hash data (a fresh Form: none cached)."""
+    fresh = ufl.Form(form.integrals())
+    fast, ufl_signature.compute_expression_hashdata = (
+        ufl_signature.compute_expression_hashdata,
+        signature.compute_expression_hashdata.original,
+    )
+    try:
+        return fresh.signature()
+    finally:
+        ufl_signature.compute_expression_hashdata = fast
+
+
+@pytest.mark.parametrize("case_id, elements, degree, condensed", MODELS)
+@pytest.mark.parametrize("order", ["run", "reversed"])
+def test_form_signatures_are_ufl_own(case_id, elements, degree, condensed, order):
+    remember_loaded_modules()
+    assert ufl_signature.compute_expression_hashdata is signature.compute_expression_hashdata
+    model = build_model(_spec(case_id, elements, degree), MPI.COMM_WORLD, (), condensed)
+    forms = _forms(model)
+    if order == "reversed":
+        forms = forms[::-1]
+    for form in forms:
+        expected = _ufl_own(form)
+        assert ufl.Form(form.integrals()).signature() == expected
+
+
+def test_expression_signatures_are_ufl_own():
+    """An expression's signature (FFCx names the section expressions by it) after a form of
+    the same model was signed: UFL's own."""
+    from ufl.algorithms.signature import compute_expression_signature
+
+    remember_loaded_modules()
+    model = build_model(_spec("bend45_vertical", 1, 4), MPI.COMM_WORLD, (), True)
+    ufl.Form(model.F.integrals()).signature()  # leaves its digests for the next call
+    expr = ufl.as_vector([*model.section_parts()[2], model.load_factor])
+    renumbering = {c: i for i, c in enumerate(ufl.algorithms.extract_coefficients(expr))}
+    renumbering[model.load_factor] = 0
+    renumbering[model.mesh.mesh.ufl_domain()] = 0
+    got = compute_expression_signature(expr, renumbering)
+    ufl_signature.compute_expression_hashdata = signature.compute_expression_hashdata.original
+    try:
+        assert got == compute_expression_signature(expr, renumbering)
+    finally:
+        ufl_signature.compute_expression_hashdata = signature.compute_expression_hashdata
+
+
+def test_digests_are_reused_only_where_the_terminals_agree():
+    """The tangent of a residual reuses the residual's digests; a form whose terminals are
+    numbered otherwise (the residual's test function as the second argument) reuses none,
+    and still gets UFL's signature."""
+    remember_loaded_modules()
+    model = build_model(_spec("sm23_end_moments", 2, 3), MPI.COMM_WORLD, (), True)
+    ufl.Form(model.F.integrals()).signature()
+    carried = signature._carried[0]
+    assert carried is not None and carried[1]
+    assert signature._reusable(_terminal_data(model.J)) is carried[1]
+    ufl.Form(model.F.integrals()).signature()
+    v = ufl.TestFunction(model.W)
+    swapped = ufl.replace(model.F, {v: ufl.TrialFunction(model.W)})  # argument number 1
+    assert signature._reusable(_terminal_data(swapped)) == {}
+    assert ufl.Form(swapped.integrals()).signature() == _ufl_own(swapped)
+
+
+def _terminal_data(form):
+    integrands = [i.integrand() for i in form.integrals()]
+    return ufl_signature.compute_terminal_hashdata(integrands, form._compute_renumbering())
+
+
+def test_the_digests_left_for_the_next_form_keep_no_model_alive():
+    remember_loaded_modules()
+    model = build_model(_spec("rollup_0.5", 2, 1), MPI.COMM_WORLD, (), True)
+    ufl.Form(model.J.integrals()).signature()
+    assert signature._carried[0] is not None
+    gone = weakref.ref(model.w)
+    del model
+    gc.collect()
+    assert gone() is None
