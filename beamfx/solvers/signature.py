@@ -20,10 +20,22 @@ digest anew for every parent.
   when every terminal of the residual has the same hash data in the tangent (UFL numbers
   coefficients, arguments and indices per form, so this is checked, term by term; otherwise
   nothing is reused). Nothing is kept alive by it.
+
+Before the hashing, a form is traversed for its terminals three times (its coefficients and
+arguments, its constants, the terminals' hash data) and an expression five times; UFL
+expressions are immutable, so :func:`unique_terminals` lists a node's terminals once and
+answers the next traversal of the same node from that list (the same terminals in the same
+order), for as long as the node lives.
 """
 
 import hashlib
 import weakref
+from functools import partial
+
+#: node id -> (weak reference to the node, its unique terminals in traversal order)
+_terminals = {}
+#: UFL's modules that traverse terminals on the way to a signature
+_TRAVERSING = ("ufl.algorithms.analysis", "ufl.algorithms.signature", "ufl.domain")
 
 #: what the last call left for the next one: [terminals [(ref, hash data)], {id: (ref, digest,
 #: spelling)}], or None
@@ -35,10 +47,43 @@ def install():
     signatures call it by its module name). Idempotent; ``.original`` is UFL's."""
     from ufl.algorithms import signature
 
-    if getattr(signature.compute_expression_hashdata, "beamfx_fast", False):
+    if signature.compute_expression_hashdata is compute_expression_hashdata:
         return
     compute_expression_hashdata.original = signature.compute_expression_hashdata
     signature.compute_expression_hashdata = compute_expression_hashdata
+    import importlib
+
+    from ufl.corealg import traversal
+
+    unique_terminals.original = traversal.traverse_unique_terminals
+    for name in _TRAVERSING:
+        importlib.import_module(name).traverse_unique_terminals = unique_terminals
+
+
+def unique_terminals(expr, visited=None):
+    """UFL's ``traverse_unique_terminals``: the terminals of ``expr``, each once (by UFL's
+    equality), in UFL's order; listed at the first call for a node and kept while it lives
+    (a weak reference removes them with it). With ``visited`` given, UFL's own traversal."""
+    if visited is not None or expr._ufl_is_terminal_:  # a terminal's list would hold it
+        return unique_terminals.original(expr, visited)
+    key = id(expr)
+    entry = _terminals.get(key)
+    if entry is None or entry[0]() is not expr:
+        found = list(unique_terminals.original(expr))
+        try:
+            ref = weakref.ref(expr, partial(_forget, _terminals, key))
+        except TypeError:  # no weak references: not kept
+            return iter(found)
+        entry = _terminals[key] = (ref, found)
+    return iter(entry[1])
+
+
+def _forget(table, key, ref):
+    """Drop the terminals of a node that died from ``table`` (unless its id names a newer
+    node already). The table is bound, not looked up: at exit module globals are gone."""
+    entry = table.get(key)
+    if entry is not None and entry[0] is ref:
+        del table[key]
 
 
 def compute_expression_hashdata(expression, terminal_hashdata):

@@ -122,12 +122,32 @@ def _terminal_data(form):
     return ufl_signature.compute_terminal_hashdata(integrands, form._compute_renumbering())
 
 
-def test_the_digests_left_for_the_next_form_keep_no_model_alive():
+def test_the_digests_and_terminals_kept_keep_no_model_alive():
+    """Digests left for the next form, and the terminal lists of the nodes traversed, go
+    with the model."""
     remember_loaded_modules()
     model = build_model(_spec("rollup_0.5", 2, 1), MPI.COMM_WORLD, (), True)
     ufl.Form(model.J.integrals()).signature()
     assert signature._carried[0] is not None
-    gone = weakref.ref(model.w)
-    del model
+    integrand = model.J.integrals()[0].integrand()
+    assert id(integrand) in signature._terminals
+    key, gone = id(integrand), weakref.ref(model.w)
+    del model, integrand
     gc.collect()
     assert gone() is None
+    assert key not in signature._terminals
+
+
+def test_terminals_are_listed_once_in_ufl_order():
+    """A node's terminals, asked for again, come from the list of the first traversal: the
+    same objects in the same order as UFL's own traversal."""
+    from ufl.algorithms import analysis
+
+    remember_loaded_modules()
+    model = build_model(_spec("bend45_vertical", 1, 4), MPI.COMM_WORLD, (), True)
+    integrand = model.F.integrals()[0].integrand()
+    own = list(signature.unique_terminals.original(integrand))
+    first = list(analysis.traverse_unique_terminals(integrand))
+    again = list(ufl_signature.traverse_unique_terminals(integrand))
+    assert signature._terminals[id(integrand)][1] is not None
+    assert [id(t) for t in first] == [id(t) for t in again] == [id(t) for t in own]
