@@ -16,8 +16,12 @@ def plain(obj: object) -> object:
     kind = type(obj)
     if kind in _SCALARS:
         return obj
-    if kind is list and all(type(v) is float for v in obj):  # a vector: copied as it is
-        return list(obj)
+    if kind is dict:  # the exact containers before the checks for NumPy, NamedTuples and
+        return {k: plain(v) for k, v in obj.items()}  # dataclasses (none of them is one)
+    if kind is list or kind is tuple:
+        if all(type(v) is float for v in obj):  # a vector: copied as it is
+            return list(obj)
+        return [plain(v) for v in obj]
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, np.generic):
