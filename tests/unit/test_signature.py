@@ -54,16 +54,21 @@ def _forms(model):
 
 
 def _ufl_own(form):
-    """The signature of ``form`` by UFL's own hash data (a fresh Form: none cached)."""
+    """The signature of ``form`` by UFL's own hash data and traversals (a fresh Form: none
+    cached)."""
+    import importlib
+
     fresh = ufl.Form(form.integrals())
-    fast, ufl_signature.compute_expression_hashdata = (
-        ufl_signature.compute_expression_hashdata,
-        signature.compute_expression_hashdata.original,
-    )
+    modules = [importlib.import_module(name) for name in signature._TRAVERSING]
+    ufl_signature.compute_expression_hashdata = signature.compute_expression_hashdata.original
+    for module in modules:
+        module.traverse_unique_terminals = signature.unique_terminals.original
     try:
         return fresh.signature()
     finally:
-        ufl_signature.compute_expression_hashdata = fast
+        ufl_signature.compute_expression_hashdata = signature.compute_expression_hashdata
+        for module in modules:
+            module.traverse_unique_terminals = signature.unique_terminals
 
 
 @pytest.mark.parametrize("case_id, elements, degree, condensed", MODELS)
