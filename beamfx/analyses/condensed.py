@@ -350,17 +350,19 @@ class CondensedModel(Discretised):
     def _quadrature_increments(self, xi, subintervals=1):
         """:meth:`_increments` by Gauss quadrature of u_ξ = ±|J| (x' − t_s) from vertex 0 to
         each node ξ_j: ``subintervals`` equal parts of [0, ξ_j], p + 2 points in each (one
-        expression compiled per count, cached)."""
+        expression compiled per count, cached). The node at vertex 0 (ξ = 0) gets zero
+        without quadrature (its points would all be ξ = 0: a quarter of a P3 cell's)."""
         from dolfinx import fem
 
         from ..solvers.forms import JIT_PARAMS
 
         m = self.mesh.mesh
         cache = self._integrator = self._integrator or {}
+        moved = xi != 0  # the nodes integrated to
         if subintervals not in cache:
             gx, gw = _gauss(self.degree + 2)
             local = (np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals
-            points = (xi[:, None] * local.ravel()[None, :]).reshape(-1, 1)
+            points = (xi[moved, None] * local.ravel()[None, :]).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| (t0·t_s) u'
             sign = ufl.dot(self.t_s, self.discretisation.t0)
             u_xi = sign * ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.t_s)
@@ -370,9 +372,11 @@ class CondensedModel(Discretised):
             weights = np.tile(gw / 2, subintervals) / subintervals
             cache[subintervals] = (expr, weights)
         expr, gw = cache[subintervals]
-        n = m.topology.index_map(1).size_local
-        vals = expr.eval(np.arange(n, dtype=np.int32)).reshape(n, len(xi), len(gw), 3)
-        return xi[None, :, None] * np.einsum("cngi,g->cni", vals, gw)
+        n, k = m.topology.index_map(1).size_local, int(np.count_nonzero(moved))
+        vals = expr.eval(np.arange(n, dtype=np.int32)).reshape(n, k, len(gw), 3)
+        inc = np.zeros((n, len(xi), 3))
+        inc[:, moved] = xi[None, moved, None] * np.einsum("cngi,g->cni", vals, gw)
+        return inc
 
     def _in_sync(self):
         """Whether ``u`` was integrated from the current ``w`` and load factor (on every

@@ -3,6 +3,7 @@ to report, how to solve. One :class:`RunContext` per ``beamfx run``."""
 
 import time
 from collections.abc import Callable
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -86,18 +87,30 @@ class RunContext:
     def step(self, model, step, time):
         """After an accepted step (static, arc length): probes tracked, the reactions (a row
         of ``reactions.csv``), and a frame where the output asks (each timed in
-        :attr:`seconds`)."""
+        :attr:`seconds`); with a frame, all three read one evaluation of the sections."""
         t0 = _now()
-        self.probe_values(model)
-        t1 = _now()
-        self.reaction_row(step, time, self.reactions(model))
-        t2 = _now()
-        if self.frames.want(step, time):
-            self.frames.write(step, time, self.latest_reactions["reactions"])
+        frame = self.frames.want(step, time)
+        with self._sharing(model, frame):
+            self.probe_values(model)
+            t1 = _now()
+            self.reaction_row(step, time, self.reactions(model))
+            t2 = _now()
+            if frame:
+                self.frames.write(step, time, self.latest_reactions["reactions"])
         seconds = self.seconds
         seconds["probes"] += t1 - t0
         seconds["reactions"] += t2 - t1
         seconds["frames"] += _now() - t2
+
+    def _sharing(self, model, frame):
+        """The context of a step's output: where its frame evaluates the sections of all
+        owned cells, the probes and reactions read that one evaluation
+        (:func:`~beamfx.io.fields.shared_fields`; the same numbers)."""
+        if frame and getattr(self.frames, "reads_sections", False):
+            from ..io.fields import shared_fields
+
+            return shared_fields(model)
+        return nullcontext()
 
     def reaction_row(self, step, time, entry):
         """A row of ``reactions.csv`` (the transient's columns without the inertia; ``time``:

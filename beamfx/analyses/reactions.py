@@ -334,7 +334,9 @@ def entries(model):
         from ..io import evaluate_points
 
         reactions, balance = (
-            condensed_reactions(model, partial(evaluate_points, model, recover=False)),
+            condensed_reactions(
+                model, partial(evaluate_points, model, recover=False, full="sections")
+            ),
             None,
         )
     return {

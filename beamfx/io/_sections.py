@@ -20,6 +20,7 @@ NumPy from ``rot`` and ``Lam0`` (:func:`rotation_matrices`).
 """
 
 import weakref
+from contextlib import contextmanager
 from functools import lru_cache
 
 import numpy as np
@@ -29,6 +30,7 @@ from ..physics.rotations import np_exp_rotation, np_rotation
 from ..solvers.forms import JIT_PARAMS
 
 _compiled = weakref.WeakKeyDictionary()  # model -> {points key: (Expression, layout)}
+_shared = weakref.WeakKeyDictionary()  # model -> its _SharedEvaluation (see shared_evaluation)
 
 
 def _layout(kin):
@@ -102,6 +104,18 @@ def evaluate(model, points, cells, recover=True, full=True):
         columns.
     """
     points = np.asarray(points, dtype=float).reshape(-1)
+    shared = _shared.get(model)
+    if shared is not None:
+        out = shared.lookup(points, cells, recover, full)
+        if out is not None:
+            return out
+    values, layout, key = _raw(model, points, cells, recover)
+    return _derive(model, values, layout, key[: len(points)], recover, full)
+
+
+def _raw(model, points, cells, recover):
+    """(the compiled expression's values at ``points`` and the Gauss points of ``cells``,
+    (cells, points, quantities); its layout; its points as a tuple)."""
     expr, layout, key = section_evaluator(model, points, recover)
     cells = np.asarray(cells, dtype=np.int32)
     size = max(s.stop for s in layout.values())
@@ -109,18 +123,92 @@ def evaluate(model, points, cells, recover=True, full=True):
         values = expr.eval(cells).reshape(len(cells), len(key), size)
     else:
         values = np.zeros((0, len(key), size))
-    n = len(points)
+    return values, layout, key
+
+
+def _derive(model, values, layout, points, recover, full, base=None):
+    """The dictionary of :func:`evaluate` from the :func:`_raw` ``values`` at ``points`` (a
+    tuple); ``base``: such a dictionary of the same values made already (with either
+    ``recover``), whose arrays other than N and M are taken as they are."""
+    n, cells = len(points), len(values)
     if not full:
         return {name: values[:, :n, layout[name]] for name in ("X", "u", "rot")}
-    out = {name: values[:, :n, s] for name, s in layout.items()}
+    if base is not None:
+        out = dict(base)
+        for name in ("N", "M"):
+            out[name] = values[:, :n, layout[name]]
+    else:
+        out = {name: values[:, :n, s] for name, s in layout.items()}
+        out["Lam0"] = out["Lam0"].reshape(cells, n, 3, 3)
+        rot = out["rot"].reshape(-1, model.kin.output_rotation_size)
+        R = rotation_matrices(model.kin.finite, rot)
+        out["axes"] = (R @ out["Lam0"].reshape(-1, 3, 3)).reshape(cells, n, 3, 3)
     if recover:
-        A = _recovery_matrix(model.degree, key[:n])
+        A = _recovery_matrix(model.degree, points)
         for name in ("N", "M"):
             out[name] = np.einsum("pg,cgi->cpi", A, values[:, n:, layout[name]])
-    out["Lam0"] = out["Lam0"].reshape(len(cells), n, 3, 3)
-    R = rotation_matrices(model.kin.finite, out["rot"].reshape(-1, model.kin.output_rotation_size))
-    out["axes"] = (R @ out["Lam0"].reshape(-1, 3, 3)).reshape(len(cells), n, 3, 3)
     return out
+
+
+@contextmanager
+def shared_evaluation(model, cells):
+    """Within the block, :func:`evaluate` at the cell nodes (:func:`cell_nodes`) of any of
+    ``cells`` (local, int32) reads one evaluation of all of them at the model's state, made at
+    the first such call: the consumers of one state (a step's probes, reactions and frame)
+    evaluate and derive the section quantities once. The values are those of separate calls,
+    bit for bit (each cell's are computed alone: the kernel per cell, the rotations and the
+    recovery per point), and read only. The state (``w``, the load factor, a condensed
+    model's ``u``) must not change inside the block. Not collective; the first evaluation is
+    where :func:`evaluate`'s first call would be (every rank makes it)."""
+    _shared[model] = _SharedEvaluation(model, cells)
+    try:
+        yield
+    finally:
+        _shared.pop(model, None)
+
+
+class _SharedEvaluation:
+    """One state's section quantities at the cell nodes of ``cells`` (see
+    :func:`shared_evaluation`), made at the first :meth:`lookup`."""
+
+    def __init__(self, model, cells):
+        self.model, self.cells = model, cells
+        self.nodes = cell_nodes(model.degree)[:, 0]
+        self.rows, self.raw, self.derived = None, None, {}
+
+    def lookup(self, points, cells, recover, full):
+        """:func:`evaluate`'s answer, or None if ``points`` are not the cell nodes or a cell
+        is not among those shared."""
+        if len(points) != len(self.nodes) or not np.array_equal(points, self.nodes):
+            return None
+        rows = None
+        if cells is not self.cells:
+            if self.rows is None:
+                self.rows = {c: i for i, c in enumerate(self.cells.tolist())}
+            rows = [self.rows.get(c) for c in np.asarray(cells).tolist()]
+            if None in rows:
+                return None
+        values = self._values(recover)
+        if not full:
+            values = {name: values[name] for name in ("X", "u", "rot")}
+        if rows is None:
+            return dict(values)
+        return {name: a[rows] for name, a in values.items()}
+
+    def _values(self, recover):
+        """The :func:`evaluate` dictionary of all the cells (read only), made once per
+        ``recover``: one kernel call for both, the axes shared."""
+        if recover not in self.derived:
+            if self.raw is None:
+                self.raw = _raw(self.model, self.nodes, self.cells, recover)
+            values, layout, key = self.raw
+            points = key[: len(self.nodes)]
+            base = next(iter(self.derived.values()), None)  # the other ``recover``'s
+            out = _derive(self.model, values, layout, points, recover, True, base)
+            for a in out.values():
+                a.flags.writeable = False
+            self.derived[recover] = out
+        return self.derived[recover]
 
 
 def section_evaluator(model, points, recover=True):

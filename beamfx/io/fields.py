@@ -9,7 +9,7 @@ import weakref
 
 import numpy as np
 
-from ._sections import cell_nodes, evaluate
+from ._sections import cell_nodes, evaluate, shared_evaluation
 
 _owned = weakref.WeakKeyDictionary()  # model -> (cells, input indices, beams)
 
@@ -41,6 +41,14 @@ def local_fields(model, recover=True):
     out = {name: np.ascontiguousarray(out[name]).reshape(-1, 3) for name in POINT_ARRAYS}
     out["cell"], out["beam"] = cell.copy(), beam.copy()
     return out
+
+
+def shared_fields(model):
+    """A context (:func:`~beamfx.io._sections.shared_evaluation`) within which the section
+    quantities of the owned cells are evaluated once at the model's current state and read
+    by :func:`local_fields` and by the probes and reactions at points of owned cells: what a
+    step that writes a frame evaluates. The state must not change inside it."""
+    return shared_evaluation(model, _owned_cells(model)[0])
 
 
 def _owned_cells(model):

@@ -192,6 +192,13 @@ class FrameWriter:
         """Whether accepted step ``step`` at ``time`` is a frame (:class:`FramePolicy`)."""
         return self.policy.want(step, time, last)
 
+    @property
+    def reads_sections(self):
+        """Whether a frame evaluates the section quantities of all owned cells (the centre
+        line, the surface or XDMF is written): the other output of its step can share them
+        (:func:`~beamfx.io.fields.shared_fields`)."""
+        return bool(self.series) or self.xdmf is not None
+
     def follow(self, model):
         """Write the state of ``model`` from now on: another formulation on the same mesh
         (the full model a condensed one fell back to); the series go on."""

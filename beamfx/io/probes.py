@@ -114,6 +114,17 @@ def _point_values(finite, v):
     return out
 
 
+def _section_values(v):
+    """``position`` and the section's ``section_axes``, ``section_force`` and
+    ``section_moment`` of one point: :func:`_point_values` without the rotation's values."""
+    return {
+        "position": (v["X"] + v["u"]).tolist(),
+        "section_axes": v["axes"].tolist(),
+        "section_force": v["N"].tolist(),
+        "section_moment": v["M"].tolist(),
+    }
+
+
 def _kinematic_values(finite, row, parts, rot):
     """``position``, ``displacement`` and the rotation (``quaternion`` of finite kinematics,
     else ``rotation_vector``) of one point: :func:`_point_values` without the rest. ``row``:
@@ -140,7 +151,9 @@ def evaluate_points(model, names=None, recover=True, full=True):
             taken pointwise at the vertex, see :func:`beamfx.io._sections.evaluate`.
         full: all the values below; if False only ``position``, ``displacement`` and the
             ``quaternion`` (finite kinematics) or ``rotation_vector`` (linear), the same
-            numbers, for a history that records them at every step.
+            numbers, for a history that records them at every step; if ``"sections"`` only
+            ``position``, ``section_axes``, ``section_force`` and ``section_moment`` (the
+            condensed model's reactions at every step).
 
     Returns:
         ``{name: values}`` on every rank, where ``values`` holds plain lists and floats:
@@ -156,7 +169,7 @@ def evaluate_points(model, names=None, recover=True, full=True):
     Raises:
         ValueError: if a name is not a named point of the model.
     """
-    comm = model.comm
+    comm, finite = model.comm, model.kin.finite
     names = list(model.mesh.points) if names is None else list(names)
     unknown = [n for n in names if n not in model.mesh.points]
     if unknown:
@@ -164,11 +177,12 @@ def evaluate_points(model, names=None, recover=True, full=True):
     model.sync()  # derived fields (the condensed model integrates its displacement)
     if full:
         found, cells = _plan(model, names)
-        values = evaluate(model, cell_nodes(model.degree), cells, recover, full)
+        values = evaluate(model, cell_nodes(model.degree), cells, recover)
         local = {}
         for i, (n, end) in enumerate(found):
             node = end * model.degree  # ξ = 0 or 1
-            local[n] = _point_values(model.kin.finite, {k: a[i, node] for k, a in values.items()})
+            v = {k: a[i, node] for k, a in values.items()}
+            local[n] = _section_values(v) if full == "sections" else _point_values(finite, v)
     else:
         local = _kinematics(model, names, recover)
 
