@@ -75,10 +75,10 @@ class PvdIndex:
 
     def read(self):
         """[(time, file)] of an existing index, [] if there is none."""
+        if not os.path.exists(self.path):
+            return []  # (a new folder: no XML parser imported, 2 ms of a process's first frame)
         import xml.etree.ElementTree as ET
 
-        if not os.path.exists(self.path):
-            return []
         root = ET.parse(self.path).getroot()
         return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
 
