@@ -6,8 +6,9 @@ axes (global axes). Consecutive outlines of one element are joined by quads; eac
 closed by an end cap at its two ends. The samples are the k + 1 nodes of each element of
 :func:`~beamfx.io.fields.nodal_fields` refined in NumPy (no new JIT form): positions X + u, N
 and M by the element's Lagrange polynomials through its nodes (exact: u and the P_k geometry
-are P_k, recovered N and M are of degree k − 1), the section axes the same way followed by
-the nearest rotation (polar decomposition), which is accurate to the interpolation error.
+are P_k, recovered N and M are of degree k − 1), the section axes the same way followed,
+between the nodes, by the nearest rotation (polar decomposition), which is accurate to the
+interpolation error; a sample at a node has the node's axes (a rotation: R·Λ0).
 The cells are the same at every frame of a run: :class:`SweptSurface` makes them once
 (:mod:`beamfx.io.surface_cells`) and a frame only its points and point arrays (:func:`sweep`).
 
@@ -102,8 +103,9 @@ def refine(fields, degree, subdivisions=4):
 
     Returns:
         dict of arrays of shape (elements, subdivisions + 1, ...): ``x`` the current position,
-        ``axes`` the current section axes as columns (3, 3), ``u``, ``N``, ``M``, and ``beam``
-        (elements,).
+        ``axes`` the current section axes as columns (3, 3; between the nodes the nearest
+        rotation to the interpolated axes, at a node its axes as given), ``u``, ``N``, ``M``,
+        and ``beam`` (elements,).
     """
     k = degree
     n_el = len(fields["X"]) // (k + 1)
@@ -116,11 +118,28 @@ def refine(fields, degree, subdivisions=4):
     out = {name: values[..., 3 * i : 3 * i + 3] for i, name in enumerate(SAMPLE_ARRAYS)}
     out["x"] = values[..., -3:]
     n = 3 * len(SAMPLE_ARRAYS)  # then e1, e2, e3: as the rows of each (3, 3), so transposed
-    axes = values[..., n : n + 9].reshape(*values.shape[:2], 3, 3).swapaxes(-1, -2)
-    U, _, Vt = np.linalg.svd(axes)  # nearest rotation: U Vᵀ (the sign is safe: axes ≈ R)
-    out["axes"] = U @ Vt
+    axes = np.ascontiguousarray(
+        values[..., n : n + 9].reshape(*values.shape[:2], 3, 3).swapaxes(-1, -2)
+    )
+    between = _between_nodes(k, subdivisions)
+    if len(between):  # nearest rotation U Vᵀ (the sign is safe: axes ≈ R)
+        U, _, Vt = np.linalg.svd(axes[:, between])
+        axes[:, between] = U @ Vt
+    out["axes"] = axes
     beam = np.asarray(fields["beam"])
     out["beam"] = (beam if len(beam) == n_el else beam.reshape(n_el, k + 1)[:, 0]).astype(np.int64)
+    return out
+
+
+@lru_cache(maxsize=8)
+def _between_nodes(degree, subdivisions):
+    """The samples of :func:`refine` that are no node of the element (their row of
+    :func:`_refinement_matrix` is not a unit vector): there the interpolated axes are not
+    orthonormal; at a node they are the node's own, a rotation already (cached, read only)."""
+    A = _refinement_matrix(degree, subdivisions)
+    at_node = (np.count_nonzero(A, axis=1) == 1) & (A.max(axis=1) == 1.0)
+    out = np.flatnonzero(~at_node)
+    out.flags.writeable = False
     return out
 
 
