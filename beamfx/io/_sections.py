@@ -193,6 +193,9 @@ class _SharedEvaluation:
             values = {name: values[name] for name in ("X", "u", "rot")}
         if rows is None:
             return dict(values)
+        if len(rows) == 1:  # (a probe's cell: views, not copies)
+            r = slice(rows[0], rows[0] + 1)
+            return {name: a[r] for name, a in values.items()}
         return {name: a[rows] for name, a in values.items()}
 
     def _values(self, recover):

@@ -14,7 +14,7 @@ import weakref
 
 import numpy as np
 
-from ..physics.rotations import axis_angle, principal_rotation_vector, unwrap_rotation_vector
+from ..physics.rotations import axis_angle, unwrap_rotation_vector
 from ._sections import cell_nodes, evaluate, section_evaluator
 
 _plans = weakref.WeakKeyDictionary()  # model -> {names: (found, cells)}
@@ -103,7 +103,7 @@ def _point_values(finite, v):
     if finite:
         axis, angle = axis_angle(rot)
         out["quaternion"] = (rot / np.linalg.norm(rot)).tolist()
-        out["rotation_vector"] = principal_rotation_vector(rot).tolist()
+        out["rotation_vector"] = _principal(axis, angle).tolist()
     else:
         angle = float(np.linalg.norm(rot))
         axis = rot / angle if angle > 0 else np.array([1.0, 0.0, 0.0])
@@ -112,6 +112,14 @@ def _point_values(finite, v):
     out["section_axes"] = v["axes"].tolist()
     out["section_force"], out["section_moment"] = v["N"].tolist(), v["M"].tolist()
     return out
+
+
+def _principal(axis, angle):
+    """:func:`~beamfx.physics.rotations.principal_rotation_vector` from the quaternion's
+    :func:`~beamfx.physics.rotations.axis_angle` found already (the same operations)."""
+    if angle > np.pi:
+        axis, angle = -axis, 2 * np.pi - angle
+    return angle * axis
 
 
 def _section_values(v):
