@@ -16,7 +16,9 @@ name       size  meaning
 N and M are recovered from the Gauss points of the cell by default (:func:`evaluate`). The
 expression is compiled once per model and set of reference points (cached on the model
 object, so a per-step writer compiles nothing). The current section axes R·Λ0 are formed in
-NumPy from ``rot`` and ``Lam0`` (:func:`rotation_matrices`).
+NumPy from ``rot`` and ``Lam0`` (:func:`rotation_matrices`). Within
+:func:`shared_evaluation` the consumers of one state (a static step's probes, reactions and
+frame) read one evaluation of all owned cells instead of evaluating their own cells each.
 """
 
 import weakref
