@@ -370,10 +370,11 @@ class CondensedModel(Discretised):
                 u_xi, points, form_compiler_params=EXACT_TABLES, jit_params=dict(JIT_PARAMS)
             )
             weights = np.tile(gw / 2, subintervals) / subintervals
-            cache[subintervals] = (expr, weights)
-        expr, gw = cache[subintervals]
-        n, k = m.topology.index_map(1).size_local, int(np.count_nonzero(moved))
-        vals = expr.eval(np.arange(n, dtype=np.int32)).reshape(n, k, len(gw), 3)
+            cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
+            cache[subintervals] = (expr, weights, cells, int(np.count_nonzero(moved)))
+        expr, gw, cells, k = cache[subintervals]
+        n = len(cells)
+        vals = expr.eval(cells).reshape(n, k, len(gw), 3)
         inc = np.zeros((n, len(xi), 3))
         inc[:, moved] = xi[None, moved, None] * np.einsum("cngi,g->cni", vals, gw)
         return inc

@@ -213,10 +213,10 @@ class PlanarCondensedModel(CondensedModel):
         if self._closed is None:  # the sections and the degree do not change
             self._closed = self.closed_form()
         if not self._closed:
-            n_cells = self.mesh.mesh.topology.index_map(1).size_local
-            theta = self.w.x.array[self.W.dofmap.list.array.reshape(-1, len(xi))[:n_cells]]
-            turn = float(np.ptp(theta, axis=1).max(initial=0.0)) if n_cells else 0.0
-            turn = self.comm.allreduce(turn, op=MPI.MAX)
+            theta = self.w.x.array[self._ends(xi)[1]]  # (the θ dofs per cell, found once)
+            turn = float(np.ptp(theta, axis=1).max(initial=0.0)) if len(theta) else 0.0
+            if self.comm.size > 1:  # (the maximum over one rank is its own)
+                turn = self.comm.allreduce(turn, op=MPI.MAX)
             parts = 2 ** int(np.ceil(np.log2(max(1.0, turn / SUBINTERVAL_ANGLE))))
             return self._quadrature_increments(xi, parts)
         cells, c, h, sign, block, force = self._data()
@@ -231,7 +231,8 @@ class PlanarCondensedModel(CondensedModel):
 
     def _ends(self, xi):
         """((ξ = 0 node, ξ = 1 node), the θ dofs per local cell, the section force of a
-        model without forces: zero) for the closed form, found once."""
+        model without forces: zero) for the closed form (the dofs for the quadrature's
+        turn too), found once."""
         if self._end_data is None:
             n_cells = self.mesh.mesh.topology.index_map(1).size_local
             dofs = self.W.dofmap.list.array.reshape(-1, len(xi))[:n_cells]
