@@ -1,5 +1,6 @@
 import os
 import textwrap
+from pathlib import Path
 
 os.environ.setdefault("SETUPTOOLS_USE_DISTUTILS", "stdlib")
 
@@ -26,6 +27,21 @@ def value_at(model, sub, xyz):
     X, vals, _ = nodal(model, sub)
     i = np.argmin(np.linalg.norm(X - np.asarray(xyz), axis=1))
     return X[i], vals[i]
+
+
+@pytest.fixture
+def shared_folder(tmp_path):
+    """One folder for all ranks of the communicator (pytest's tmp_path differs between them):
+    rank 0's, removed after the test (with all ranks done)."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    name = comm.bcast(str(tmp_path / "shared") if comm.rank == 0 else None)
+    if comm.rank == 0:
+        os.makedirs(name, exist_ok=True)
+    comm.barrier()
+    yield Path(name)
+    comm.barrier()
 
 
 @pytest.fixture

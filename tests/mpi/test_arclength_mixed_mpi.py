@@ -5,9 +5,6 @@ eigenvector and the deflation are collective. Howcroft's shallow arch
 bifurcation and limit point (the inextensible arch's path, u ≡ 0 up to round-off, is no test:
 its load factors per step follow the round-off of its displacements)."""
 
-import tempfile
-from pathlib import Path
-
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -15,7 +12,7 @@ from mpi4py import MPI
 pytestmark = pytest.mark.mpi
 
 
-def test_mixed_trace_is_the_same_on_all_ranks():
+def test_mixed_trace_is_the_same_on_all_ranks(shared_folder):
     from beamfx.bench.shallow_arch import scene_data
     from beamfx.runner import run_scene
     from beamfx.scene.load import parse_scene
@@ -24,8 +21,7 @@ def test_mixed_trace_is_the_same_on_all_ranks():
     data["model"] = {"formulation": "mixed"}
     data["analysis"].update(max_steps=12)
     scene = parse_scene(data, "arch.toml")
-    name = tempfile.mkdtemp(prefix="beamfx_mpi_") if MPI.COMM_WORLD.rank == 0 else None
-    folder = Path(MPI.COMM_WORLD.bcast(name))
+    folder = shared_folder
     rank = MPI.COMM_WORLD.rank
     log = lambda *a, **k: None
     serial = run_scene("s.toml", folder / f"s{rank}", comm=MPI.COMM_SELF, scene=scene, log=log)

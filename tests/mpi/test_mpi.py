@@ -84,19 +84,10 @@ def test_transient_matches_serial():
     assert np.allclose(parallel, serial, rtol=1e-8, atol=1e-10), (parallel, serial)
 
 
-def _shared_folder():
-    """One temporary folder for all ranks (pytest's tmp_path differs between ranks)."""
-    import tempfile
-    from pathlib import Path
-
-    name = tempfile.mkdtemp(prefix="beamfx_mpi_") if MPI.COMM_WORLD.rank == 0 else None
-    return Path(MPI.COMM_WORLD.bcast(name))
-
-
 @pytest.mark.parametrize(
     "values", [[[0, 0, 150], [0, 0, 300], [0, 0, 600]], [[0, 0, 600]]], ids=["3-members", "1"]
 )
-def test_sweep_ensemble_matches_serial(values):
+def test_sweep_ensemble_matches_serial(values, shared_folder):
     """A sweep on split communicators (3 members: groups of one rank; 1 member: one group of
     all ranks) gives the probes each member's scene gives on one process."""
     import json
@@ -108,7 +99,7 @@ def test_sweep_ensemble_matches_serial(values):
     data = {**load_scene_data(), "sweep": [{"key": "loads[0].force", "values": values}]}
     data["model"] = {"condense": "none"}  # the quaternion model (the condensed one: above)
     sweep = parse_sweep(json.loads(json.dumps(data)), "sweep.toml")
-    folder = _shared_folder()
+    folder = shared_folder
     table = run_sweep(sweep, folder / "ensemble", run_scene)
     assert table["groups"] == min(len(values), MPI.COMM_WORLD.size)
     for row, member in zip(table["members"], sweep.members):
@@ -171,7 +162,7 @@ def _docs_scene(analysis):
 
 
 @pytest.mark.parametrize("analysis", ["arclength", "rotating", "buckling", "linear_static"])
-def test_documented_scene_runs_the_same_on_all_ranks(analysis):
+def test_documented_scene_runs_the_same_on_all_ranks(analysis, shared_folder):
     """``beamfx run`` of the documented scene of each analysis from one process and from all
     ranks: the same probes and, where the analysis has them, the same eigenvalues and path."""
     import tomllib
@@ -180,7 +171,7 @@ def test_documented_scene_runs_the_same_on_all_ranks(analysis):
     from beamfx.scene import parse_scene
 
     scene = parse_scene(tomllib.loads(_docs_scene(analysis)), f"{analysis}.toml")
-    folder = _shared_folder()
+    folder = shared_folder
     rank = MPI.COMM_WORLD.rank
     serial = run_scene("s.toml", folder / f"serial{rank}", comm=MPI.COMM_SELF, scene=scene)
     parallel = run_scene("s.toml", folder / "parallel", scene=scene)
