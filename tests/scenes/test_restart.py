@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scenekit import SPIN_HISTORY, spun_beam
+from test_reactions import CANTILEVER
 
 from beamfx.cli import main
 from beamfx.io.output import default_every
@@ -271,26 +272,7 @@ def test_a_fresh_run_removes_the_files_of_an_earlier_run(tmp_path, capsys):
     assert Path(out / "probes.csv").read_text().count("\n") == 4  # header, t = 0 and 2 steps
 
 
-STATIC = """
-[material]
-E = 1.0e7
-nu = 0.3
-[[beams]]
-name = "b"
-curve = { shape = "line", start = [0, 0, 0], end = [10, 0, 0] }
-section = { type = "rectangle", h = 0.1, w = 0.1 }
-elements = 2
-degree = 2
-[[supports]]
-at = "b:start"
-fix = "all"
-[[loads]]
-at = "b:end"
-force = [0, 0, -10]
-[analysis]
-type = "static"
-steps = 2
-"""
+STATIC = CANTILEVER.replace("KIN", "finite").replace("CONDENSE", "auto")  # 2 load steps
 
 
 def test_restart_of_a_static_run_is_a_fresh_run_and_says_so(tmp_path, capsys):
