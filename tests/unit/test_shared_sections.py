@@ -58,21 +58,19 @@ def _same(a, b):
 @pytest.mark.parametrize("kind, degree", [("planar", 3), ("condensed", 2), ("full", 3)])
 def test_shared_evaluation_gives_each_consumer_its_own_numbers(kind, degree):
     model = _solved(kind, degree)
-    alone = (
-        evaluate_points(model, POINTS),
-        evaluate_points(model, POINTS, recover=False),
-        evaluate_points(model, POINTS, full=False),
-        entries(model),
-        local_fields(model),
-    )
-    with shared_fields(model):
-        shared = (
+
+    def consumers():
+        return (
             evaluate_points(model, POINTS),
             evaluate_points(model, POINTS, recover=False),
             evaluate_points(model, POINTS, full=False),
             entries(model),
             local_fields(model),
         )
+
+    alone = consumers()
+    with shared_fields(model):
+        shared = consumers()
     for a, b in zip(alone, shared):
         assert _same(a, b)
     sections = evaluate_points(model, POINTS, recover=False, full="sections")
