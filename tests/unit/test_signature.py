@@ -156,3 +156,80 @@ def test_terminals_are_listed_once_in_ufl_order():
     again = list(ufl_signature.traverse_unique_terminals(integrand))
     assert signature._terminals[id(integrand)][1] is not None
     assert [id(t) for t in first] == [id(t) for t in again] == [id(t) for t in own]
+
+
+def _random_forms(seed, trials):
+    """Forms of random expressions that share subexpressions (the same objects) across forms
+    and trials, with test and trial functions, coefficients of two spaces, a constant and
+    free indices: residuals, their derivatives and functionals, in a shuffled order."""
+    import random
+
+    rng = random.Random(seed)
+    cell = ufl.triangle
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, 1))
+    V = ufl.FunctionSpace(domain, ufl.FiniteElement("Lagrange", cell, 1))
+    W = ufl.FunctionSpace(domain, ufl.VectorElement("Lagrange", cell, 2))
+    scalars = [ufl.Coefficient(V) for _ in range(4)] + [ufl.Constant(domain)]
+    vectors = [ufl.Coefficient(W) for _ in range(2)]
+    pool = []
+
+    def scalar(depth=0):
+        r = rng.random()
+        if depth > 3 or r < 0.3:
+            return rng.choice(scalars + [ufl.as_ufl(rng.choice((1.0, 2.0)))])
+        if pool and r < 0.45:
+            return rng.choice(pool)
+        a, b = scalar(depth + 1), scalar(depth + 1)
+        g = ufl.grad(rng.choice(vectors))
+        e = rng.choice(
+            (
+                lambda: a * b,
+                lambda: a + b,
+                lambda: ufl.sin(a),
+                lambda: ufl.dot(g[0, :], ufl.as_vector([a, b])),
+                lambda: ufl.inner(g, ufl.grad(rng.choice(vectors))) * a,
+                lambda: ufl.conditional(ufl.lt(a, b), a, b),
+            )
+        )()
+        pool.append(e)
+        return e
+
+    for _ in range(trials):
+        v, u, c = ufl.TestFunction(V), ufl.TrialFunction(V), rng.choice(scalars[:4])
+        F = scalar() * v * ufl.dx + scalar() * ufl.inner(ufl.grad(v), ufl.grad(c)) * ufl.ds
+        forms = [F, ufl.derivative(F, rng.choice(scalars[:4]), u), (scalar() + c) * ufl.dx]
+        rng.shuffle(forms)
+        yield from forms
+
+
+def test_random_forms_sharing_nodes_are_signed_as_ufl_does():
+    """UFL's signature on forms whose nodes recur across forms with other numberings of their
+    coefficients, arguments and indices (the digests carried from form to form are reused
+    only where they hold: without the terminals' check, dozens of these differ)."""
+    remember_loaded_modules()
+    for form in _random_forms(1, 60):
+        assert ufl.Form(form.integrals()).signature() == _ufl_own(form)
+
+
+def test_digests_of_freed_nodes_are_not_taken_by_new_nodes_at_their_ids():
+    """Forms over the same terminals, each freed before the next is built (whose nodes then
+    take the freed ids while the digests carried from form to form are reused): UFL's
+    signature every time."""
+    import random
+
+    remember_loaded_modules()
+    rng = random.Random(3)
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.triangle, 1))
+    V = ufl.FunctionSpace(domain, ufl.FiniteElement("Lagrange", ufl.triangle, 1))
+    f, g, v = ufl.Coefficient(V), ufl.Coefficient(V), ufl.TestFunction(V)
+    ops = (lambda a, b: a * b, lambda a, b: a + b, lambda a, b: ufl.sin(a) - b)
+
+    def tree(depth):
+        if depth == 0:
+            return rng.choice((f, g))
+        return rng.choice(ops)(tree(depth - 1), tree(rng.randrange(depth)))
+
+    for _ in range(200):
+        form = (tree(4) + f * g) * v * ufl.dx
+        assert ufl.Form(form.integrals()).signature() == _ufl_own(form)
+        del form
