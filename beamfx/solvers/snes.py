@@ -221,9 +221,12 @@ class NewtonSolver:
         reactions), bitwise as an assembly of F there would give; None if it was not kept
         (:meth:`keep_residual`), was evaluated elsewhere or included a lifting."""
         kept = self._kept
-        if kept is None or kept[2] or not (kept[0] == self.x.getArray(readonly=True)).all():
-            return None
-        return kept[1]
+        ok = kept is not None and not kept[2] and (kept[0] == self.x.getArray(readonly=True)).all()
+        if self.comm.size > 1:  # the same answer on every rank: a None makes them assemble
+            from mpi4py import MPI
+
+            ok = self.comm.allreduce(bool(ok), op=MPI.LAND)
+        return kept[1] if ok else None
 
     def solve(self):
         """Run Newton from the current ``w``; ``w`` holds the last iterate. Returns a report."""
