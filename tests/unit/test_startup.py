@@ -21,6 +21,28 @@ def test_a_singleton_asks_for_ob1_and_no_daemon_and_mpirun_or_the_user_keep_thei
     assert not startup.mpi_singleton(env) and env == mine
 
 
+def test_a_singletons_child_is_a_singleton_not_a_second_rank_0():
+    """What a singleton's MPI start exports (its job's PMIx namespace, rank 0) is dropped by
+    a process it starts; an mpirun-launched rank keeps its own."""
+    child = {
+        "OMPI_MCA_ess": "singleton",
+        "PMIX_RANK": "0",
+        "PMIX_NAMESPACE": "123@0",
+        "PMIX_SERVER_URI4": "x",
+        "PMIX_MCA_psec": "native",
+        "OMPI_MCA_orte_launch": "1",
+        "OMPI_APP_CTX_NUM_PROCS": "1",
+    }
+    assert startup.mpi_singleton(child)
+    assert child == {
+        "PMIX_MCA_psec": "native",
+        "OMPI_MCA_pml": "ob1",
+        "OMPI_MCA_ess_singleton_isolated": "1",
+    }
+    rank = {"OMPI_MCA_ess": "^singleton", "PMIX_RANK": "1", "OMPI_COMM_WORLD_SIZE": "2"}
+    assert not startup.mpi_singleton(dict(rank))
+
+
 def test_an_isolated_singleton_runs_mpi_and_io(tmp_path):
     """A singleton without OpenMPI's support daemon still does what a run does: collectives,
     and MPI-IO through HDF5 (the XDMF output)."""
