@@ -185,10 +185,14 @@ class _SharedEvaluation:
             return None
         rows = None
         if cells is not self.cells:
-            if self.rows is None:
-                self.rows = {c: i for i, c in enumerate(self.cells.tolist())}
-            rows = [self.rows.get(c) for c in np.asarray(cells).tolist()]
-            if None in rows:
+            if self.rows is None:  # cell -> its row, -1 for a cell not shared (NumPy, no loop)
+                self.rows = np.full(int(self.cells.max(initial=-1)) + 1, -1, dtype=np.int64)
+                self.rows[self.cells] = np.arange(len(self.cells))
+            cells = np.asarray(cells, dtype=np.int64)
+            if len(cells) and (cells.min() < 0 or cells.max() >= len(self.rows)):
+                return None
+            rows = self.rows[cells]
+            if (rows < 0).any():
                 return None
         values = self._values(recover)
         if not full:
@@ -196,7 +200,7 @@ class _SharedEvaluation:
         if rows is None:
             return dict(values)
         if len(rows) == 1:  # (a probe's cell: views, not copies)
-            r = slice(rows[0], rows[0] + 1)
+            r = slice(int(rows[0]), int(rows[0]) + 1)
             return {name: a[r] for name, a in values.items()}
         return {name: a[rows] for name, a in values.items()}
 
