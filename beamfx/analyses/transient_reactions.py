@@ -41,7 +41,6 @@ import numpy as np
 
 from ..io.reaction_files import ReactionCsv, columns
 from ..physics.rotations import _norm  # np.linalg.norm's value, without its checks
-from .checks import model_size
 from .dofs import constrained_dofs, owned_size
 from .reactions import ReactionRecovery, imbalance
 
@@ -83,7 +82,6 @@ class TransientReactions:
         self.size = len(dyn.model.w.x.array)  # owned and ghost entries
         held = constrained_dofs(dyn.model.bcs)
         self.free[held[held < len(self.free)]] = False
-        self.length = model_size(dyn.model.spec)  # the balance's length scale
 
     def __call__(self, residual=None):
         """``({point: Reaction}, DynamicBalance)``; ``residual``: the step's residual (owned
@@ -113,7 +111,7 @@ class TransientReactions:
             applied[6] + inert[6],
             applied[7] + inert[7],
             reactions,
-            self.length,
+            rec.length,
         )
         balance = DynamicBalance(
             *ratios,
