@@ -15,8 +15,12 @@ one P1 element rolls a beam up into any number of turns. The centre line
 x' = R(θ)(t_s + Λ0 Γ) is then integrated cell by cell in closed form (:func:`chord_increments`)
 where θ is linear in a cell (P1, straight cells, sections constant in the cell), so the
 roll-up is exact to round-off; otherwise by composite Gauss quadrature with the cell split
-until θ turns by at most :data:`SUBINTERVAL_ANGLE` in a part.
+until θ turns by at most :data:`SUBINTERVAL_ANGLE` in a part: in NumPy where the cells are
+straight and the sections constant in them (:func:`gauss_increments`, the same rule as the
+compiled expression of the spatial model's quadrature, which curved cells still use).
 """
+
+from functools import cache
 
 import numpy as np
 import ufl
@@ -24,7 +28,7 @@ from mpi4py import MPI
 
 from ..physics import condensed as rod
 from ..physics.kinematics import PLANES, plane_normal
-from .condensed import CondensedModel
+from .condensed import CondensedModel, _gauss
 
 #: largest turn of θ in one part of a cell in the quadrature of the centre line (radians):
 #: p + 2 Gauss points per part then integrate cos θ and sin θ to about 1e-16
@@ -43,6 +47,11 @@ def _integral_exp(theta0, delta):
     return np.exp(1j * (theta0 + delta / 2)) * np.sinc(delta / (2 * np.pi))
 
 
+def _block_parts(A):
+    """(α, δ) of 2 × 2 symmetric blocks A = α I + D, D v = δ v̄ (plane complex numbers)."""
+    return 0.5 * (A[:, 0, 0] + A[:, 1, 1]), 0.5 * (A[:, 0, 0] - A[:, 1, 1]) + 1j * A[:, 0, 1]
+
+
 def chord_increments(theta0, theta1, chord, h, sign, A, n):
     r"""u(ξ = 1) − u(ξ = 0) of straight cells with θ linear in ξ, all in plane complex numbers.
 
@@ -57,12 +66,55 @@ def chord_increments(theta0, theta1, chord, h, sign, A, n):
     ``chord`` and ``n`` complex (:func:`plane_complex`), ``A`` (n_cells, 2, 2), the in-plane
     block.
     """
-    alpha = 0.5 * (A[:, 0, 0] + A[:, 1, 1])
-    delta = 0.5 * (A[:, 0, 0] - A[:, 1, 1]) + 1j * A[:, 0, 1]
+    alpha, delta = _block_parts(A)
     bend = chord * (_integral_exp(theta0, theta1 - theta0) - 1)
     turn = _integral_exp(2 * theta0, 2 * (theta1 - theta0))
     strain = sign * h * (alpha * n + delta * np.conj(n) * turn)
     return bend + strain
+
+
+def gauss_increments(theta, xi, parts, chord, h, sign, A, n):
+    r"""u(ξ_j) − u(0) at the nodes ξ_j of straight cells, θ of any degree.
+
+    In plane complex numbers (cells, len(ξ)), with x_ξ as in :func:`chord_increments`:
+
+        Δu_j = c (∫₀^ξj e^{iθ} − ξ_j) + σ h (α n ξ_j + δ n̄ ∫₀^ξj e^{2iθ}),
+
+    each integral by the composite Gauss rule of the compiled quadrature
+    (:meth:`~beamfx.analyses.condensed.CondensedModel._quadrature_increments`): ``parts`` equal
+    parts of [0, ξ_j], p + 2 points in each. ``theta`` (cells, p + 1) holds the nodal angles in
+    the order of ``xi`` (the nodes' reference points); the other arguments as in
+    :func:`chord_increments`.
+    """
+    weights, basis = _gauss_rule(tuple(xi.tolist()), parts)
+    th = (theta @ basis.T).reshape(len(theta), len(xi), -1)  # θ at each node's points
+    e = np.cos(th) + 1j * np.sin(th)  # (a third of np.exp's time for complex arguments)
+    ints = e @ weights, (e * e) @ weights  # ∫₀^ξj e^{iθ}, ∫₀^ξj e^{2iθ}, over ξ_j
+    alpha, delta = _block_parts(A)
+    x = np.asarray(xi)[None, :]
+    bend = chord[:, None] * x * (ints[0] - 1)
+    strain = (
+        (sign * h)[:, None]
+        * x
+        * (alpha[:, None] * n[:, None] + (delta * np.conj(n))[:, None] * ints[1])
+    )
+    return bend + strain
+
+
+@cache
+def _gauss_rule(xi, parts):
+    """(weights summing to 1, the Lagrange basis of the nodes ``xi`` at each node's points
+    (len(ξ) · points, len(ξ))) of the composite Gauss rule on [0, ξ_j] (read only)."""
+    from ..io._sections import lagrange_matrix
+
+    gx, gw = _gauss(len(xi) + 1)  # p + 2 points
+    local = ((np.arange(parts)[:, None] + (gx[None, :] + 1) / 2) / parts).ravel()
+    weights = np.tile(gw / 2, parts) / parts
+    nodes = np.asarray(xi)
+    basis = np.concatenate([lagrange_matrix(nodes, xj * local) for xj in nodes])
+    for a in (weights, basis):
+        a.flags.writeable = False
+    return weights, basis
 
 
 def cell_values(f, n_cells):
@@ -117,7 +169,7 @@ class PlanarCondensedModel(CondensedModel):
             raise ValueError("the planar condensed model needs a planar model (kinematics.plane)")
         self.normal = plane_normal(model.kinematics)
         self._n = np.eye(3)[PLANES[model.kinematics.plane][2]]
-        self._cell_data = self._closed = self._end_data = None
+        self._cell_data = self._closed = self._straight = self._end_data = None
         super().__init__(model, comm, extra_points)
 
     # --- the rotation parametrisation -------------------------------------------------------
@@ -168,9 +220,32 @@ class PlanarCondensedModel(CondensedModel):
     def closed_form(self):
         """Whether :meth:`sync` integrates the centre line in closed form: P1 (straight cells,
         θ linear) and every section field constant in a cell."""
+        return self.degree == 1 and self._constant_sections()
+
+    def _constant_sections(self):
         d = self.discretisation
-        constant = all(f.function_space.ufl_element().degree() == 0 for f in (d.stiffness, d.twist))
-        return self.degree == 1 and constant
+        return all(f.function_space.ufl_element().degree() == 0 for f in (d.stiffness, d.twist))
+
+    def straight_cells(self):
+        """Whether :meth:`sync` integrates the centre line in NumPy (:func:`gauss_increments`):
+        every section field constant in a cell, and every cell straight with |J| constant: its
+        geometry nodes (equispaced in ξ, :func:`~beamfx.geometry.mesh.build_mesh`) at
+        X0 + ξ (X1 − X0), to 1e-12 of its length; on every rank (collective)."""
+        m = self.mesh.mesh
+        n = m.topology.index_map(1).size_local
+        x = m.geometry.x[m.geometry.dofmap.array.reshape(-1, self.degree + 1)[:n]]
+        chord = x[:, 1] - x[:, 0]  # vertices first, then the interior nodes
+        length2 = np.einsum("ci,ci->c", chord, chord)
+        along = np.einsum("cki,ci->ck", x - x[:, :1], chord) / length2[:, None]
+        off = x - x[:, :1] - along[..., None] * chord[:, None, :]
+        k = self.degree  # the equispaced nodes' ξ in DOLFINx's order: 0, 1, 1/k, ..., (k-1)/k
+        steps = along - np.array([0.0, 1.0, *np.arange(1, k) / k])[: k + 1]
+        tol = 1e-12 * np.sqrt(length2)
+        straight = bool(
+            np.all(np.linalg.norm(off, axis=2) <= tol[:, None])
+            and np.all(np.abs(steps) * np.sqrt(length2)[:, None] <= tol[:, None])
+        )
+        return self.comm.allreduce(straight and self._constant_sections(), op=MPI.LAND)
 
     def _data(self):
         """Per local cell: its cells' indices, chord (plane complex) and its length, σ, the
@@ -185,14 +260,14 @@ class PlanarCondensedModel(CondensedModel):
         d, m = self.discretisation, self.mesh.mesh
         if self._cell_data is None:
             cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
-            nodes = m.geometry.dofmap.array.reshape(-1, 2)[: len(cells)]
-            chord = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]
+            nodes = m.geometry.dofmap.array.reshape(-1, self.degree + 1)[: len(cells)]
+            chord = m.geometry.x[nodes[:, 1]] - m.geometry.x[nodes[:, 0]]  # vertices first
             AA = np.zeros((len(cells), 3))  # the Kirchhoff rod: no compliance
             if self.kin.shear or self.kin.stretch:
                 C = cell_values(d.stiffness, len(cells))
                 kept = [self.kin.stretch, self.kin.shear, self.kin.shear]
                 compliance = np.where(kept, 1.0 / C[:, :3], 0.0)
-                t = chord / np.linalg.norm(chord, axis=1)[:, None]  # t0 = J/|J| (P1)
+                t = chord / np.linalg.norm(chord, axis=1)[:, None]  # t0 = J/|J| (straight)
                 reference = cell_values(d.reference, len(cells))
                 twist = cell_values(d.twist, len(cells))[:, 0]
                 AA = compliance_blocks(t, reference, twist, compliance, self.kin.plane)
@@ -209,24 +284,30 @@ class PlanarCondensedModel(CondensedModel):
     def _increments(self, xi):
         """u(node) − u(vertex 0) per local cell: closed form where θ is linear in a straight
         cell (:meth:`closed_form`), else composite Gauss with parts of at most
-        :data:`SUBINTERVAL_ANGLE` of turn."""
-        if self._closed is None:  # the sections and the degree do not change
+        :data:`SUBINTERVAL_ANGLE` of turn: in NumPy in straight cells
+        (:meth:`straight_cells`), else by the compiled expression of the spatial model."""
+        if self._closed is None:  # the sections, the geometry and the degree do not change
             self._closed = self.closed_form()
+            self._straight = not self._closed and self.straight_cells()
+        ends, dofs, n_zero = self._ends(xi)
+        theta = self.w.x.array[dofs]
         if not self._closed:
-            theta = self.w.x.array[self._ends(xi)[1]]  # (the θ dofs per cell, found once)
             turn = float(np.ptp(theta, axis=1).max(initial=0.0)) if len(theta) else 0.0
             if self.comm.size > 1:  # (the maximum over one rank is its own)
                 turn = self.comm.allreduce(turn, op=MPI.MAX)
             parts = 2 ** int(np.ceil(np.log2(max(1.0, turn / SUBINTERVAL_ANGLE))))
-            return self._quadrature_increments(xi, parts)
+            if not self._straight:
+                return self._quadrature_increments(xi, parts)
         cells, c, h, sign, block, force = self._data()
-        ends, dofs, n_zero = self._ends(xi)
-        theta = self.w.x.array[dofs]
         n = plane_complex(force.eval(cells).reshape(-1, 3), self.kin.plane) if force else n_zero
         (i0, i1), (a, b) = ends, PLANES[self.kin.plane][:2]
-        du = chord_increments(theta[:, i0], theta[:, i1], c, h, sign, block, n)
         inc = np.zeros((len(cells), len(xi), 3))
-        inc[:, i1, a], inc[:, i1, b] = du.real, du.imag
+        if self._closed:
+            du = chord_increments(theta[:, i0], theta[:, i1], c, h, sign, block, n)
+            inc[:, i1, a], inc[:, i1, b] = du.real, du.imag
+        else:
+            du = gauss_increments(theta, xi, parts, c, h, sign, block, n)
+            inc[:, :, a], inc[:, :, b] = du.real, du.imag
         return inc
 
     def _ends(self, xi):
@@ -247,5 +328,6 @@ __all__ = [
     "cell_values",
     "chord_increments",
     "compliance_blocks",
+    "gauss_increments",
     "plane_complex",
 ]

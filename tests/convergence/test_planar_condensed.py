@@ -10,13 +10,20 @@ from mpi4py import MPI
 from beamfx.analyses.condensed import CondensedModel
 from beamfx.analyses.formulation import BeamFormulation, Formulation
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.planar_condensed import PlanarCondensedModel, build_model, chord_increments
+from beamfx.analyses.planar_condensed import (
+    PlanarCondensedModel,
+    build_model,
+    chord_increments,
+    gauss_increments,
+    plane_complex,
+)
 from beamfx.analyses.static import solve_static
 from beamfx.bench._builders import cantilever, straight
 from beamfx.bench.classic import ROLL_SECTION, L
+from beamfx.geometry.curves import Arc
 from beamfx.io import evaluate_points
 from beamfx.physics import sections
-from beamfx.physics.kinematics import Kinematics
+from beamfx.physics.kinematics import PLANES, Kinematics
 
 XZ = Kinematics(plane="xz")
 SEC = sections.rectangle(1e4, 0.5e4, 1.0, 0.1, 0.1, nu=0.0)  # EA / (EI/L²) = 1200: stretch shows
@@ -79,6 +86,45 @@ def test_closed_form_chord_matches_quadrature():
         )
         x_xi = np.exp(1j * th) * c[k] + sign[k] * h[k] * np.exp(1j * th) * arn
         assert abs(np.sum(w * x_xi) - c[k] - got[k]) < 1e-13
+
+
+@pytest.mark.parametrize("degree", [2, 3, 4])
+def test_numpy_quadrature_matches_the_compiled_one(degree):
+    """Straight cells of P2–P4: the centre line's composite Gauss rule in NumPy
+    (:func:`gauss_increments`, what :meth:`sync` uses there) against the same rule evaluated
+    by the compiled expression of the spatial model (``_quadrature_increments``, what curved
+    cells use), at a bent state with a section force and an anisotropic compliance (a
+    follower tip force of 5 EI/L²; stretch and shear kept), for 1, 2 and 4 parts: the same
+    sums of 20–80 terms of size ≤ h, so the same numbers to round-off (1e-14 of L = 1)."""
+    force = (0.0, 0.0, 5 * SEC.EI_y)
+    spec = cantilever(straight(1.0), SEC, 4, degree, force=force, follower=True, kinematics=XZ)
+    model, _, _ = _tip(PlanarCondensedModel, spec)
+    assert model.straight_cells() and not model.closed_form()
+    xi = model._xi
+    cells, c, h, sign, block, force_expr = model._data()
+    theta = model.w.x.array[model._ends(xi)[1]]
+    assert np.ptp(theta, axis=1).max() > 0.3  # bent: the parts matter
+    n = plane_complex(force_expr.eval(cells).reshape(-1, 3), "xz")
+    a, b, normal = PLANES["xz"]
+    for parts in (1, 2, 4):
+        got = gauss_increments(theta, xi, parts, c, h, sign, block, n)
+        compiled = model._quadrature_increments(xi, parts)
+        assert np.abs(got.real - compiled[..., a]).max() < 1e-14
+        assert np.abs(got.imag - compiled[..., b]).max() < 1e-14
+        assert np.abs(compiled[..., normal]).max() < 1e-14
+    # the rule converges: 1 part against 4 differs by the rule's error, not round-off
+    coarse = gauss_increments(theta, xi, 1, c, h, sign, block, n)
+    fine = gauss_increments(theta, xi, 4, c, h, sign, block, n)
+    assert np.abs(coarse - fine).max() < 1e-9
+
+
+def test_curved_cells_keep_the_compiled_quadrature():
+    """A plane arc (a quarter circle in xz): its cells are curved, so :meth:`sync` keeps the
+    compiled quadrature (the NumPy rule assumes a constant |J| t0)."""
+    curve = Arc((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), 90.0)
+    spec = cantilever(curve, SEC, 4, 3, force=(0.0, 0.0, 0.1 * SEC.EI_y), kinematics=XZ)
+    model = PlanarCondensedModel(spec)
+    assert not model.straight_cells()
 
 
 @pytest.mark.parametrize("follower", [False, True])
