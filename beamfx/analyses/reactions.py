@@ -298,51 +298,40 @@ def _near(layout, dofs):
     return near, u_rows
 
 
-def condensed_reactions(model, evaluate):
-    """Reaction at the clamp of the statically condensed cantilever, from the section
-    resultants at its start: force −RΛ0 N (statically exact: N is the sum of the loads beyond
-    the section), moment −RΛ0 M (M = C_M K recovered from the curvature, accurate to the
-    discretisation). ``evaluate(names)``: the probe values of the points (collective)."""
-    out = {}
-    for sup in model.spec.supports:
-        v = evaluate([sup.at])[sup.at]
-        axes = np.asarray(v["section_axes"])
-        force = -axes @ np.asarray(v["section_force"])
-        moment = -axes @ np.asarray(v["section_moment"])
-        out[sup.at] = Reaction(force.tolist(), moment.tolist(), list(v["position"]))
-    return out
-
-
-#: model -> its ReactionRecovery (forms compiled once), or None for a model that is no
-#: BeamFormulation (the condensed one): the Protocol's isinstance, about 50 µs, asked once
+#: model -> its ReactionRecovery (forms compiled once), or for a model that is no
+#: BeamFormulation (the condensed one) the dict of its load points' dofs: the Protocol's
+#: isinstance, about 50 µs, asked once
 _recoveries = weakref.WeakKeyDictionary()
 
 
 def entries(model):
-    """The ``reactions`` ({point: {force, moment, position}}) and ``reaction_balance`` (None
-    for the condensed model) entries of results.json at the model's current state. Collective.
-    """
+    """The ``reactions`` ({point: {force, moment, position}}) and ``reaction_balance``
+    entries of results.json at the model's current state; the condensed model's balance
+    (:mod:`~beamfx.analyses.condensed_reactions`) says ``reactions_from``. Collective."""
     from .formulation import BeamFormulation
 
     if model not in _recoveries:
         beam = isinstance(model, BeamFormulation)
-        _recoveries[model] = ReactionRecovery(model) if beam else None
+        _recoveries[model] = ReactionRecovery(model) if beam else {}
     recovery = _recoveries[model]
-    if recovery is not None:
+    if isinstance(recovery, ReactionRecovery):
         reactions, balance = recovery()
+        balance = balance._asdict()
     else:
         from ..io import evaluate_points
+        from .condensed_reactions import condensed_reactions
 
-        reactions, balance = (
-            condensed_reactions(
-                model, partial(evaluate_points, model, recover=False, full="sections")
-            ),
-            None,
-        )
+        evaluate = partial(evaluate_points, model, recover=False, full="sections")
+        reactions, balance = condensed_reactions(model, evaluate, recovery)
+        balance = {**balance._asdict(), "reactions_from": CONDENSED_SOURCE}
     return {
         "reactions": {at: r._asdict() for at, r in reactions.items()},
-        "reaction_balance": None if balance is None else balance._asdict(),
+        "reaction_balance": balance,
     }
+
+
+#: ``reaction_balance.reactions_from`` of the statically condensed model
+CONDENSED_SOURCE = "the section resultants at the clamp (statically condensed model)"
 
 
 def balance_line(entry):
@@ -356,14 +345,11 @@ def balance_line(entry):
             f"max |ΣF|/scale = {balance['max_force']:.1e}, "
             f"max |ΣM|/scale = {balance['max_moment']:.1e}"
         )
-    if balance is None:
-        return (
-            f"reactions: {n} support(s), from the section resultants at the clamp "
-            "(statically condensed model)"
-        )
+    source = balance.get("reactions_from")
+    where = f"{n} support(s), from {source}" if source else f"{n} point(s)"
     applied = np.round(balance["applied_force"], 12).tolist()
     return (
-        f"reactions: {n} point(s); balance with the applied loads (force {applied}): "
+        f"reactions: {where}; balance with the applied loads (force {applied}): "
         f"|ΣF|/scale = {balance['force']:.1e}, |ΣM|/scale = {balance['moment']:.1e}"
     )
 
@@ -373,7 +359,6 @@ __all__ = [
     "Reaction",
     "ReactionRecovery",
     "balance_line",
-    "condensed_reactions",
     "entries",
     "resultant",
 ]
