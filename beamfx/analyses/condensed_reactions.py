@@ -6,8 +6,8 @@ with them the displacement unknowns, are eliminated): the reaction is the sectio
 at the clamp, force −RΛ0 N (statically exact: N is the sum of the loads beyond the section)
 and moment −RΛ0 M (M = C_M K recovered from the curvature, accurate to the discretisation).
 
-The balance is computed the same way as the full model's
-(:func:`~beamfx.analyses.reactions.imbalance`), from the model's own load data at the
+The balance (:func:`beamfx.analyses.reactions.condensed_reactions`) is computed the same way
+as the full model's (:func:`~beamfx.analyses.reactions.imbalance`), from the model's own load data at the
 current state, not from the section resultants: each point load at the load factor λ, a
 follower force turned by R at its point, a moment as :meth:`CondensedModel.spatial_moment
 <beamfx.analyses.condensed.CondensedModel.spatial_moment>` gives it (the one its virtual work
@@ -19,9 +19,6 @@ pure end moment, the discretisation error of M otherwise).
 
 import numpy as np
 from mpi4py import MPI
-
-from .checks import model_size
-from .reactions import Balance, Reaction, imbalance
 
 
 def _vertex_dofs(model, at):
@@ -69,11 +66,11 @@ def applied_loads(model, cache):
     return out
 
 
-def load_balance(reactions, loads, positions, length):
-    """:class:`~beamfx.analyses.reactions.Balance` of ``reactions`` ({at: Reaction}) with
-    ``loads`` ([(at, force, moment)], global axes) acting at ``positions`` ({at: x}): the
-    applied force Σ f and moment Σ (x × f + m) about the origin, and |Σ reactions + Σ loads|
-    relative to the loads' scales Σ|f| and Σ(|x||f| + |m|) as the full model's."""
+def load_resultant(loads, positions):
+    """``(applied, force scale, moment scale)`` of ``loads`` ([(at, force, moment)], global
+    axes) acting at ``positions`` ({at: x}): applied = (Σ f, Σ (x × f + m) about the origin),
+    the scales Σ|f| and Σ(|x||f| + |m|), as the full model's
+    (:class:`~beamfx.analyses.reactions.Balance`)."""
     applied, f_scale, m_scale = np.zeros(6), 0.0, 0.0
     for at, f, m in loads:
         x = np.asarray(positions[at], float)
@@ -81,34 +78,27 @@ def load_balance(reactions, loads, positions, length):
         applied[3:] += np.cross(x, f) + m
         f_scale += float(np.linalg.norm(f))
         m_scale += float(np.linalg.norm(x) * np.linalg.norm(f) + np.linalg.norm(m))
-    total = applied.copy()
-    for r in reactions.values():
-        force = np.asarray(r.force, float)
-        total[:3] += force
-        total[3:] += np.asarray(r.moment, float) + np.cross(r.position, force)
-    ratios = imbalance(total, f_scale, m_scale, reactions, length)
-    return Balance(*ratios, applied[:3].tolist(), applied[3:].tolist())
+    return applied, f_scale, m_scale
 
 
-def condensed_reactions(model, evaluate, cache=None):
-    """``({support: Reaction}, Balance)`` of the statically condensed cantilever at its
-    current state: the section resultants at the supports (force −RΛ0 N, moment −RΛ0 M) and
-    their :func:`load_balance` with the point loads. ``evaluate(names)``: the probe values of
-    the points (collective), one call for the supports and the loads; ``cache``: a dict kept
-    across calls for the load points' dofs. Collective."""
-    supports = [sup.at for sup in model.spec.supports]
-    names = list(dict.fromkeys(supports + [ld.at for ld in model.spec.point_loads]))
-    values = evaluate(names)
+def section_reactions(model, values):
+    """``{support: (force, moment, position)}`` (lists, global axes) from the section
+    resultants at the supports: force −RΛ0 N, moment −RΛ0 M; ``values``: the points' probe
+    values (:func:`~beamfx.io.evaluate_points`, ``full="sections"``)."""
     out = {}
-    for at in supports:
-        v = values[at]
+    for sup in model.spec.supports:
+        v = values[sup.at]
         axes = np.asarray(v["section_axes"])
         force = -axes @ np.asarray(v["section_force"])
         moment = -axes @ np.asarray(v["section_moment"])
-        out[at] = Reaction(force.tolist(), moment.tolist(), list(v["position"]))
-    loads = applied_loads(model, {} if cache is None else cache)
-    positions = {at: values[at]["position"] for at in names}
-    return out, load_balance(out, loads, positions, model_size(model.spec))
+        out[sup.at] = (force.tolist(), moment.tolist(), list(v["position"]))
+    return out
 
 
-__all__ = ["applied_loads", "condensed_reactions", "load_balance", "point_unknowns"]
+def points(model):
+    """The named points the reactions and the balance read: the supports', the loads'."""
+    at = [sup.at for sup in model.spec.supports] + [ld.at for ld in model.spec.point_loads]
+    return list(dict.fromkeys(at))
+
+
+__all__ = ["applied_loads", "load_resultant", "point_unknowns", "points", "section_reactions"]

@@ -38,6 +38,7 @@ import ufl
 from mpi4py import MPI
 
 from ..spec import DOF_NAMES
+from . import condensed_reactions as condensed_parts
 from .checks import model_size
 from .dofs import constrained_dofs, owned_size
 
@@ -298,6 +299,37 @@ def _near(layout, dofs):
     return near, u_rows
 
 
+def load_balance(reactions, applied, f_scale, m_scale, length):
+    """:class:`Balance` of ``reactions`` ({at: Reaction}) with the loads of resultant
+    ``applied`` (6: Σ force, Σ moment about the origin) and scales ``f_scale``, ``m_scale``:
+    |Σ reactions + Σ loads| relative to the scales (:func:`imbalance`)."""
+    total = np.array(applied, float)
+    for r in reactions.values():
+        force = np.asarray(r.force, float)
+        total[:3] += force
+        total[3:] += np.asarray(r.moment, float) + np.cross(r.position, force)
+    ratios = imbalance(total, f_scale, m_scale, reactions, length)
+    return Balance(*ratios, list(map(float, applied[:3])), list(map(float, applied[3:6])))
+
+
+def condensed_reactions(model, evaluate, cache):
+    """``({support: Reaction}, Balance)`` of the statically condensed cantilever at its
+    current state (:mod:`~beamfx.analyses.condensed_reactions`): the section resultants at
+    the supports and their balance with the point loads, taken from the model's load data
+    at the current load factor, rotations and positions. ``evaluate(names)``: the probe
+    values of the points (collective); ``cache``: a dict kept across calls for the load
+    points' dofs. Collective."""
+    values = evaluate(condensed_parts.points(model))
+    out = {
+        at: Reaction(*parts)
+        for at, parts in condensed_parts.section_reactions(model, values).items()
+    }
+    loads = condensed_parts.applied_loads(model, cache)
+    positions = {at: v["position"] for at, v in values.items()}
+    resultant = condensed_parts.load_resultant(loads, positions)
+    return out, load_balance(out, *resultant, model_size(model.spec))
+
+
 #: model -> its ReactionRecovery (forms compiled once), or for a model that is no
 #: BeamFormulation (the condensed one) the dict of its load points' dofs: the Protocol's
 #: isinstance, about 50 µs, asked once
@@ -319,7 +351,6 @@ def entries(model):
         balance = balance._asdict()
     else:
         from ..io import evaluate_points
-        from .condensed_reactions import condensed_reactions
 
         evaluate = partial(evaluate_points, model, recover=False, full="sections")
         reactions, balance = condensed_reactions(model, evaluate, recovery)
@@ -359,6 +390,8 @@ __all__ = [
     "Reaction",
     "ReactionRecovery",
     "balance_line",
+    "condensed_reactions",
     "entries",
+    "load_balance",
     "resultant",
 ]

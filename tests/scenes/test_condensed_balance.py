@@ -18,9 +18,9 @@ from test_reaction_output import csv_rows
 from test_reactions import _quiet
 
 from beamfx.analyses.condensed import CondensedModel, left_jacobian
-from beamfx.analyses.condensed_reactions import load_balance
+from beamfx.analyses.condensed_reactions import load_resultant
 from beamfx.analyses.model import BeamModel
-from beamfx.analyses.reactions import Reaction, entries
+from beamfx.analyses.reactions import Reaction, entries, load_balance
 from beamfx.analyses.static import solve_static
 from beamfx.bench.output_cost import ROLLUP
 from beamfx.runner import run_scene
@@ -52,13 +52,13 @@ def test_a_wrong_reaction_shows_in_the_balance():
     """The balance is a check, not an identity: the clamp reaction of a tip force F at
     x = (2, 0.5, 0) balances it to round-off; 1 % off in the force or the moment shows."""
     F, x = np.array([3.0, -4.0, 12.0]), np.array([2.0, 0.5, 0.0])
-    loads, positions = [("tip", F, np.zeros(3))], {"tip": x}
+    applied = load_resultant([("tip", F, np.zeros(3))], {"tip": x})
     right = Reaction((-F).tolist(), (-np.cross(x, F)).tolist(), [0.0, 0.0, 0.0])
-    b = load_balance({"clamp": right}, loads, positions, 2.0)
+    b = load_balance({"clamp": right}, *applied, 2.0)
     assert b.force < 1e-15 and b.moment < 1e-15
     assert b.applied_force == F.tolist() and np.allclose(b.applied_moment, np.cross(x, F))
     for wrong in (right._replace(force=(-1.01 * F).tolist()), right._replace(moment=[0, 0, 1])):
-        b = load_balance({"clamp": wrong}, loads, positions, 2.0)
+        b = load_balance({"clamp": wrong}, *applied, 2.0)
         assert max(b.force, b.moment) > 1e-3
 
 
