@@ -42,8 +42,8 @@ def sudden_loads(spec, t_end, start="rest"):
     The time integrators start with zero acceleration, so for them such a load jumps on
     during the first step, and the trapezoidal work ½ (f(0) + f(h))·Δq of that step is not
     the work it did (twice it for a constant load, but with "extrapolated":
-    :func:`jump_line`): the balance's ``numerical`` share holds the difference. Returns their descriptions, e.g. ``["the point load at 'b:end'"]``.
-    """
+    :func:`jump_line`): the balance's ``numerical`` share holds the difference. Returns
+    their descriptions, e.g. ``["the point load at 'b:end'"]``."""
     if start == "static":
         return []
     out = []
