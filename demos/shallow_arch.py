@@ -132,7 +132,9 @@ assert abs(q_bif - q_buckling) <= q_bracket + 1e-7 * q_bif
 assert abs(q_bif / bounds["q_shallow"] - 1) < (1.522 / 15.307) ** 2
 assert bounds["q_deep_follower"] < q_bif
 # the trace switched branch there and reached the displacement limit on the secondary branch
-assert point["switched"] and bif.stopped_by == "stop" and end["displacement"][2] <= -3.0
+assert (
+    point["switched"] and bif.stopped_by == "displacement_limit" and end["displacement"][2] <= -3.0
+)
 assert any(p.get("note") == "branch switch" for p in bif.path)
 
 if rank0:

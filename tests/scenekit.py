@@ -10,6 +10,42 @@ from beamfx.physics.sections import Section, tube
 from beamfx.spec import Beam, Model, PointLoad, Support
 
 E, G, RHO = 210e9, 80.77e9, 7850.0
+
+# A cantilever under a follower force and moment at its tip, a semitangential moment and a
+# dead force at mid-length: the statically condensed model's loads of every kind (its tip
+# turns by about 11 degrees)
+CONDENSED_LOADS = """
+[material]
+E = 210e9
+nu = 0.3
+[[beams]]
+name = "b"
+curve = { shape = "line", start = [0, 0, 0], end = [2, 0, 0] }
+section = { type = "rectangle", h = 0.1, w = 0.05 }
+elements = 4
+degree = 3
+[[supports]]
+at = "b:start"
+fix = "all"
+[[loads]]
+at = "b:end"
+force = [0, 2e4, 6e4]
+moment = [0, 3e4, 0]
+kind = "follower"
+[[loads]]
+at = "b:0.5"
+moment = [2e4, 0, 1e4]
+kind = "semitangential"
+[[loads]]
+at = "b:0.5"
+force = [0, -3e4, 0]
+[model]
+kinematics = "finite"
+plane = "none"
+[analysis]
+type = "static"
+steps = 4
+"""
 CLAMP = ("ux", "uy", "uz", "rx", "ry", "rz")
 
 # A clamped steel strip shaken at its root (analysis type replaced by the test)

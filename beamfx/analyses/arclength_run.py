@@ -90,7 +90,9 @@ class Result(_Base):
     control_point: str = entry("the traced point")
     path: tuple = entry("load factor, displacement and arc length of every accepted point")
     limit_points: tuple = entry("maxima and minima of the load factor along the path")
-    stopped_by: str = entry("target, stop (displacement limit) or max_steps")
+    stopped_by: str = entry(
+        "target, displacement_limit (at the first point at or past it) or max_steps"
+    )
     critical_points: tuple = entry(
         "limit and bifurcation points passed: where the number of negative eigenvalues of the "
         "tangent changed, the step and load-factor interval, the located load factor (and "
@@ -186,6 +188,8 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
             + (f": at load factor {c['load_factor']:.8g}" if c["load_factor"] is not None else "")
             + (", secondary branch followed from here" if c["switched"] else "")
         )
+    if result.reason == "displacement_limit":
+        ctx.log(limit_line(result, settings.displacement_limit))
     short = result.reason == "max_steps"  # neither the target nor the limit was reached
     why = f"max_steps: {settings.max_steps} steps did not reach the end asked for"
     return Result(
@@ -200,6 +204,21 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         limit_points=tuple(limits),
         stopped_by=result.reason,
         critical_points=tuple(critical),
+    )
+
+
+def limit_line(result, displacement_limit):
+    """The log line of a trace ended by ``displacement_limit`` (component, value): the value
+    reached at the last point against the limit; the trace stops at the first accepted point
+    at or past the limit, it does not land on it."""
+    comp, value = displacement_limit
+    last = result.path[-1]
+    reached = float(last.displacement[DOF_NAMES.index(comp)])
+    return (
+        f"stopped: displacement limit reached: {comp} of {result.control_point} = "
+        f"{reached:.6g} at load factor {last.load_factor:.6g} (step {len(result.path) - 1}), "
+        f"past the limit |{comp}| = {abs(value):.6g} (the trace stops at the first point at or "
+        "past the limit; it does not land on it)"
     )
 
 

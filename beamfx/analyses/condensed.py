@@ -28,7 +28,7 @@ import ufl
 from mpi4py import MPI
 
 from ..physics import condensed as rod
-from ..physics.rotations import np_exp_rotation
+from ..physics.rotations import np_exp_rotation, np_hat
 from ..spec import resolve_point
 from .discretisation import Discretised, discretise
 from .dofs import constrained_dofs, global_size, owned_size
@@ -48,6 +48,19 @@ EXACT_TABLES = {"table_rtol": 1e-15, "table_atol": 1e-15}
 def _gauss(points):
     """Gauss-Legendre points and weights on [-1, 1] (an eigenvalue solve: once per count)."""
     return np.polynomial.legendre.leggauss(points)
+
+
+def left_jacobian(g):
+    """J(ψ) = I + (1 − cos θ)/θ² ψ̂ + (θ − sin θ)/θ³ ψ̂² (θ = |ψ|): the spatial virtual
+    rotation δθ = axial(δR Rᵀ) = J δψ of R = exp(ψ̂) (NumPy, one vector; Taylor series of
+    both factors below θ = 1e-4)."""
+    W = np_hat(g)
+    theta = float(np.linalg.norm(g))
+    if theta < 1e-4:
+        a, b = 0.5 - theta**2 / 24, 1 / 6 - theta**2 / 120
+    else:
+        a, b = (1 - np.cos(theta)) / theta**2, (theta - np.sin(theta)) / theta**3
+    return np.eye(3) + a * W + b * (W @ W)
 
 
 class RotationRangeError(ValueError):
@@ -235,6 +248,18 @@ class CondensedModel(Discretised):
                 ufl.dot(M, quaternion_rotation_vector(rod.rotation_quaternion(g))), g, v
             )
         return ufl.dot(M, rod.virtual_rotation(g, v, spatial=ld.kind == "dead"))
+
+    def spatial_moment(self, ld, g):
+        """The moment (global axes) that the point load ``ld``'s moment exerts at the nodal
+        unknowns ``g`` of its point (NumPy), the one :meth:`_moment_work` does work with:
+        dead M, follower R M, semitangential J⁻ᵀ M (potential M·ψ, ψ = g; δθ = J δψ with J
+        the left Jacobian of exp, :func:`left_jacobian`), all times the load factor."""
+        M = float(self.load_factor.value) * np.asarray(ld.moment, float)
+        if ld.kind == "follower":
+            return self.np_rotation(g) @ M
+        if ld.kind == "semitangential":
+            return np.linalg.solve(left_jacobian(g).T, M)
+        return M
 
     # --- forms ------------------------------------------------------------------------------
 

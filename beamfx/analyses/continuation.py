@@ -47,7 +47,8 @@ class ContinuationResult(NamedTuple):
     path: tuple  # PathPoint, the first one the starting state
     control_point: str
     steps: tuple  # ArcLengthStep records of the solver
-    reason: str  # why the trace ended: "target", "stop" (displacement limit, stop), "max_steps"
+    reason: str  # why the trace ended: "target", "displacement_limit", "stop" (the caller's
+    # stop callback) or "max_steps"
     seconds: dict  # wall time split: compile, assemble_F, assemble_J, solve, inertia, locate,
     # total
     critical_points: tuple = ()  # CriticalPoint records (beamfx.solvers.bifurcation)
@@ -102,9 +103,12 @@ def trace_path(
             increment ``first_load_increment`` on the linear tangent.
         first_load_increment: see ``arc_length``.
         displacement_limit: ``(component, value)`` with component in "ux", "uy", "uz": stop
-            once that displacement of the control point reaches ``|value|`` in magnitude.
+            once that displacement of the control point reaches ``|value|`` in magnitude (at
+            the first accepted point at or past it: the trace does not land on the limit);
+            the reason is then "displacement_limit".
         stop: ``stop(path) -> bool`` called with the list of :class:`PathPoint` after each
-            step; True ends the trace (e.g. once the load has dropped past a limit point).
+            step; True ends the trace (e.g. once the load has dropped past a limit point),
+            the reason "stop".
         settings: :class:`~beamfx.solvers.arclength.ArcLengthSettings` (follower loads are
             detected from the model).
         options: PETSc options of the linear solver (without the prefix).
@@ -135,11 +139,7 @@ def trace_path(
     compile_time = compile_seconds[0] - c0
     path, record = _recorder(model, dofs, on_step)
 
-    def stop_here(step):
-        if comp is not None and abs(path[-1].displacement[comp]) >= abs(limit):
-            return True
-        return bool(stop is not None and stop(path))
-
+    stop_here, stopped = _stopper(path, comp, limit, stop)
     try:
         result = solver.trace(
             arc_length, first_load_increment, max_steps, target_load_factor, stop_here, record, log
@@ -149,9 +149,26 @@ def trace_path(
     model.set_load_factor(float(model.load_factor.value))  # the support values follow λ
     seconds = {"compile": compile_time, **result.seconds, "total": time.perf_counter() - t0}
     path[0] = path[0]._replace(negative_eigenvalues=result.negative_eigenvalues)
+    reason = stopped[-1] if result.reason == "stop" else result.reason
     return ContinuationResult(
-        tuple(path), control_point, result.steps, result.reason, seconds, result.critical_points
+        tuple(path), control_point, result.steps, reason, seconds, result.critical_points
     )
+
+
+def _stopper(path, comp, limit, stop):
+    """(``stop_here(step)`` for the solver: the displacement limit of component ``comp``
+    (None: none) reached at the last point of ``path``, or the caller's ``stop(path)``; the
+    list whose last item says which ended the trace: "displacement_limit" or "stop")."""
+    stopped = []
+
+    def stop_here(step):
+        if comp is not None and abs(path[-1].displacement[comp]) >= abs(limit):
+            stopped.append("displacement_limit")
+            return True
+        stopped.append("stop")
+        return bool(stop is not None and stop(path))
+
+    return stop_here, stopped
 
 
 def _control(spec, control_point, displacement_limit):

@@ -205,6 +205,11 @@ class PlanarCondensedModel(CondensedModel):
         semitangential, since R n = n."""
         return float(np.dot(ld.moment, self._n)) * v
 
+    def spatial_moment(self, ld, g):
+        """The moment (global axes) of :meth:`_moment_work` at any angle: (M·n) n times the
+        load factor (its other components do no work)."""
+        return float(self.load_factor.value) * float(np.dot(ld.moment, self._n)) * self._n
+
     # --- state ------------------------------------------------------------------------------
 
     def largest_angle(self):

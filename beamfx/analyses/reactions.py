@@ -38,6 +38,7 @@ import ufl
 from mpi4py import MPI
 
 from ..spec import DOF_NAMES
+from . import condensed_reactions as condensed_parts
 from .checks import model_size
 from .dofs import constrained_dofs, owned_size
 
@@ -298,51 +299,70 @@ def _near(layout, dofs):
     return near, u_rows
 
 
-def condensed_reactions(model, evaluate):
-    """Reaction at the clamp of the statically condensed cantilever, from the section
-    resultants at its start: force −RΛ0 N (statically exact: N is the sum of the loads beyond
-    the section), moment −RΛ0 M (M = C_M K recovered from the curvature, accurate to the
-    discretisation). ``evaluate(names)``: the probe values of the points (collective)."""
-    out = {}
-    for sup in model.spec.supports:
-        v = evaluate([sup.at])[sup.at]
-        axes = np.asarray(v["section_axes"])
-        force = -axes @ np.asarray(v["section_force"])
-        moment = -axes @ np.asarray(v["section_moment"])
-        out[sup.at] = Reaction(force.tolist(), moment.tolist(), list(v["position"]))
-    return out
+def load_balance(reactions, applied, f_scale, m_scale, length):
+    """:class:`Balance` of ``reactions`` ({at: Reaction}) with the loads of resultant
+    ``applied`` (6: Σ force, Σ moment about the origin) and scales ``f_scale``, ``m_scale``:
+    |Σ reactions + Σ loads| relative to the scales (:func:`imbalance`)."""
+    total = np.array(applied, float)
+    for r in reactions.values():
+        force = np.asarray(r.force, float)
+        total[:3] += force
+        total[3:] += np.asarray(r.moment, float) + np.cross(r.position, force)
+    ratios = imbalance(total, f_scale, m_scale, reactions, length)
+    return Balance(*ratios, list(map(float, applied[:3])), list(map(float, applied[3:6])))
 
 
-#: model -> its ReactionRecovery (forms compiled once), or None for a model that is no
-#: BeamFormulation (the condensed one): the Protocol's isinstance, about 50 µs, asked once
+def condensed_reactions(model, evaluate, cache):
+    """``({support: Reaction}, Balance)`` of the statically condensed cantilever at its
+    current state (:mod:`~beamfx.analyses.condensed_reactions`): the section resultants at
+    the supports and their balance with the point loads, taken from the model's load data
+    at the current load factor, rotations and positions. ``evaluate(names)``: the probe
+    values of the points (collective); ``cache``: a dict kept across calls for the load
+    points' dofs. Collective."""
+    values = evaluate(condensed_parts.points(model))
+    out = {
+        at: Reaction(*parts)
+        for at, parts in condensed_parts.section_reactions(model, values).items()
+    }
+    loads = condensed_parts.applied_loads(model, cache)
+    positions = {at: v["position"] for at, v in values.items()}
+    resultant = condensed_parts.load_resultant(loads, positions)
+    return out, load_balance(out, *resultant, model_size(model.spec))
+
+
+#: model -> its ReactionRecovery (forms compiled once), or for a model that is no
+#: BeamFormulation (the condensed one) the dict of its load points' dofs: the Protocol's
+#: isinstance, about 50 µs, asked once
 _recoveries = weakref.WeakKeyDictionary()
 
 
 def entries(model):
-    """The ``reactions`` ({point: {force, moment, position}}) and ``reaction_balance`` (None
-    for the condensed model) entries of results.json at the model's current state. Collective.
-    """
+    """The ``reactions`` ({point: {force, moment, position}}) and ``reaction_balance``
+    entries of results.json at the model's current state; the condensed model's balance
+    (:mod:`~beamfx.analyses.condensed_reactions`) says ``reactions_from``. Collective."""
     from .formulation import BeamFormulation
 
     if model not in _recoveries:
         beam = isinstance(model, BeamFormulation)
-        _recoveries[model] = ReactionRecovery(model) if beam else None
+        _recoveries[model] = ReactionRecovery(model) if beam else {}
     recovery = _recoveries[model]
-    if recovery is not None:
+    if isinstance(recovery, ReactionRecovery):
         reactions, balance = recovery()
+        balance = balance._asdict()
     else:
         from ..io import evaluate_points
 
-        reactions, balance = (
-            condensed_reactions(
-                model, partial(evaluate_points, model, recover=False, full="sections")
-            ),
-            None,
-        )
+        evaluate = partial(evaluate_points, model, recover=False, full="sections")
+        reactions, balance = condensed_reactions(model, evaluate, recovery)
+        balance = {**balance._asdict(), "reactions_from": CONDENSED_SOURCE}
     return {
         "reactions": {at: r._asdict() for at, r in reactions.items()},
-        "reaction_balance": None if balance is None else balance._asdict(),
+        "reaction_balance": balance,
     }
+
+
+#: ``reaction_balance.reactions_from`` of the statically condensed model
+CONDENSED_SOURCE = "the section resultants at the clamp (statically condensed model)"
 
 
 def balance_line(entry):
@@ -356,14 +376,11 @@ def balance_line(entry):
             f"max |ΣF|/scale = {balance['max_force']:.1e}, "
             f"max |ΣM|/scale = {balance['max_moment']:.1e}"
         )
-    if balance is None:
-        return (
-            f"reactions: {n} support(s), from the section resultants at the clamp "
-            "(statically condensed model)"
-        )
+    source = balance.get("reactions_from")
+    where = f"{n} support(s), from {source}" if source else f"{n} point(s)"
     applied = np.round(balance["applied_force"], 12).tolist()
     return (
-        f"reactions: {n} point(s); balance with the applied loads (force {applied}): "
+        f"reactions: {where}; balance with the applied loads (force {applied}): "
         f"|ΣF|/scale = {balance['force']:.1e}, |ΣM|/scale = {balance['moment']:.1e}"
     )
 
@@ -375,5 +392,6 @@ __all__ = [
     "balance_line",
     "condensed_reactions",
     "entries",
+    "load_balance",
     "resultant",
 ]

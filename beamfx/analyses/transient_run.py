@@ -119,7 +119,9 @@ class Result(_Base):
     t_end: float = entry("end time asked (s)")
     time_steps: int = entry("accepted time steps")
     restarted_from: float | None = entry("time of the checkpoint restarted from, or None")
-    energy: dict | None = entry("energy balance at the last step")
+    energy: dict | None = entry(
+        "energy balance at the last step (with a note where loads jump at t = 0)"
+    )
     probe_history: dict = entry("the files of the probe history")
     reaction_history: dict | None = entry(
         "reactions.csv (the reactions at the output steps), its rows and the largest |force| "
@@ -202,6 +204,20 @@ def _start(model, settings, ctx):
     return saved
 
 
+def _warn(ctx, settings):
+    """Log, before the march, the support motions that jump and the loads that act
+    suddenly at t = 0 (:func:`~beamfx.analyses.energy_balance.sudden_loads`: the energy
+    balance's first step); returns those loads."""
+    from .energy_balance import jump_line, sudden_loads
+
+    for w in motion_warnings(ctx.spec, settings.t_end):
+        ctx.log(f"warning: {w}")
+    jumps = sudden_loads(ctx.spec, settings.t_end, settings.start)
+    if jumps:
+        ctx.log(jump_line(jumps, settings.scheme))
+    return jumps
+
+
 def _reaction_steps(ctx):
     """``want(step, time, last)`` of the rows of reactions.csv: the frames' (default), or
     every step with ``[output] reaction_rows = "steps"``."""
@@ -233,12 +249,12 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """March to ``t_end`` (or on from the last checkpoint), writing the history as it goes;
     a SIGINT or SIGTERM stops it at a step ("stopped", with a checkpoint)."""
     from ..interrupt import deferred
+    from .energy_balance import JUMP_NOTE
     from .restart import checkpoint_writer
     from .transient import TransientFailed, solve_transient
     from .transient_reactions import ReactionSeries
 
-    for w in motion_warnings(ctx.spec, settings.t_end):
-        ctx.log(f"warning: {w}")
+    jumps = _warn(ctx, settings)
     saved = _start(model, settings, ctx)
     t_restart = saved[0]["t"] if saved else None
     history = History(ctx.folder, ctx.probes, ctx.comm, ctx.probe_blocks(model), t_restart)
@@ -302,7 +318,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         t_end=settings.t_end,
         time_steps=len(result.steps),
         restarted_from=t_restart,
-        energy=energy or None,
+        energy={**energy, **({"note": JUMP_NOTE} if jumps else {})} if energy else None,
         probe_history={"csv": history.csv.name, "jsonl": history.jsonl.name},
         reaction_history=series.summary() if series.latest is not None else None,
         stopped_by=result.stopped_by,

@@ -27,14 +27,12 @@ def columns(points, transient=True):
 
 def static_row(step, load_factor, entry):
     """The row of :func:`columns` (``transient=False``) of a static or arc-length step from its
-    results.json ``entry`` (:func:`~beamfx.analyses.reactions.entries`); the balance cells are
-    NaN where there is none (the statically condensed model)."""
+    results.json ``entry`` (:func:`~beamfx.analyses.reactions.entries`, the statically
+    condensed model's too)."""
     row = [step, load_factor]
     for r in entry["reactions"].values():
         row += [*r["force"], *r["moment"], *r["position"]]
     b = entry["reaction_balance"]
-    if b is None:
-        return row + [float("nan")] * 8
     return row + [*b["applied_force"], *b["applied_moment"], b["force"], b["moment"]]
 
 

@@ -80,7 +80,7 @@ class ArcLengthResult(NamedTuple):
     """The accepted steps of an arc-length trace, why it ended and its wall times."""
 
     steps: tuple  # accepted ArcLengthStep records
-    reason: str  # "target", "stop", "max_steps"
+    reason: str  # "target", "stop" (the ``stop`` callback of the trace), "max_steps"
     seconds: dict  # wall time split: assemble_F, assemble_J, solve, inertia, locate, total
     critical_points: tuple = ()  # CriticalPoint records, in path order
     negative_eigenvalues: int | None = None  # at the starting state

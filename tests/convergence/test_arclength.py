@@ -210,7 +210,7 @@ def test_lee_frame_from_its_scene_file(tmp_path):
     top = results["limit_points"][0]
     assert top["kind"] == "maximum"
     assert abs(top["load_factor"] - P_MAX) <= P3_NE10_RTOL * P_MAX
-    assert results["stopped_by"] == "stop"
+    assert results["stopped_by"] == "displacement_limit"
     assert abs(results["path"][-1]["displacement"][1]) >= 55
     rows = (tmp_path / "out" / "path.csv").read_text().splitlines()
     assert len(rows) == len(results["path"])  # header + one row per step after the start

@@ -42,7 +42,7 @@ def test_nearly_inextensible_arch_snaps_on_its_own_path(tmp_path):
     from beamfx.bench.shallow_arch import Q_SNAP, E, I, R, S
 
     result = run_arch(tmp_path, 1e6, 8, 4)
-    assert result.status == "converged" and result.stopped_by == "stop"
+    assert result.status == "converged" and result.stopped_by == "displacement_limit"
     assert max(p["negative_eigenvalues"] for p in result.path) == 2
     euler = math.pi**2 * E * I / S**2
     bifurcation, bound = 4 * euler / R / Q_SNAP, 9 * euler / R / Q_SNAP

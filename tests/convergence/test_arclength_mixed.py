@@ -90,7 +90,7 @@ def test_stiff_arch_traced_in_mixed_form_follows_the_trend(tmp_path):
     stiff_run = trace(tmp_path, "shallow_arch_snap", 1e6)
     stiff = stiff_run.result
     assert stiff_run.model["formulation"]["name"] == "mixed"
-    assert stiff.status == "converged" and stiff.stopped_by == "stop"
+    assert stiff.status == "converged" and stiff.stopped_by == "displacement_limit"
     limit = _first(stiff, "limit")
     exact = _first(rigid, "bifurcation")["load_factor"]  # exact constraints: factor ∞
     move_2 = exact - _first(soft, "bifurcation")["load_factor"]

@@ -54,7 +54,7 @@ def test_stiff_arch_snaps_through(tmp_path):
     from beamfx.bench.shallow_arch import A, E, theory_loads
 
     result = run_arch(tmp_path, 1e2)
-    assert result.status == "converged" and result.stopped_by == "stop"
+    assert result.status == "converged" and result.stopped_by == "displacement_limit"
     assert len(result.load_steps) < 100
     bifurcation = next(c for c in result.critical_points if c["kind"] == "bifurcation")
     expected = theory_loads(1e2 * E * A)["q_bifurcation"] / 5500.0

@@ -121,7 +121,7 @@ def test_branch_switching_follows_the_elastica(linear_factor):
     assert all(p.negative_eigenvalues == 0 for p in after)
     v = np.array([p.displacement[1] for p in after])
     assert np.all(np.diff(v) > 0) and v[-1] >= 0.5 * L
-    assert result.reason == "stop"
+    assert result.reason == "displacement_limit"
     # the elastica: P/P_b(δ) = (2K(k)/π)² with 2k/K(k) = δ/L (K(m = k²))
     lam_b = point.load_factor
     errors = []

@@ -111,3 +111,39 @@ def test_tower_scene_runs_on_two_ranks_with_the_reactions_of_one(tmp_path_factor
     for name, p in serial["probes"].items():
         a, b = parallel["probes"][name]["displacement"], p["displacement"]
         assert np.allclose(a, b, rtol=1e-8, atol=1e-12), name
+
+
+@pytest.mark.parametrize("planar", [False, True])
+def test_condensed_reaction_balance_matches_serial(planar):
+    """The statically condensed model's reactions and balance (its load points' unknowns
+    from the ranks that own them) are the same on every rank and as from one process: the
+    spatial model under loads of every kind, the planar one under a tip follower force."""
+    from dataclasses import replace
+
+    from scenekit import CONDENSED_LOADS
+
+    from beamfx.analyses.planar_condensed import build_model
+    from beamfx.physics.kinematics import Kinematics
+    from beamfx.spec import PointLoad
+
+    spec = parse_scene(tomllib.loads(CONDENSED_LOADS)).model
+    if planar:
+        tip = PointLoad("b:end", (0.0, 0.0, 6e4), (0.0, -3e4, 0.0), "follower")
+        spec = replace(spec, point_loads=(tip,), kinematics=Kinematics(plane="xz"))
+    out = {}
+    for comm in (MPI.COMM_SELF, MPI.COMM_WORLD):
+        model = build_model(spec, comm, condense=True)
+        solve_static(model, steps=4)
+        out[comm.size] = entries(model)
+    parallel, serial = out[MPI.COMM_WORLD.size], out[1]
+    every = MPI.COMM_WORLD.allgather(parallel)
+    assert all(e == parallel for e in every)  # the same entries on every rank
+    bal, ser = parallel["reaction_balance"], serial["reaction_balance"]
+    scale = np.linalg.norm(ser["applied_force"]) * 2.0  # force × length
+    for key, s in (("applied_force", scale / 2), ("applied_moment", scale)):
+        assert np.allclose(bal[key], ser[key], rtol=0, atol=1e-10 * s), key
+    r, rs = parallel["reactions"]["b:start"], serial["reactions"]["b:start"]
+    assert np.allclose(r["force"], rs["force"], rtol=0, atol=1e-10 * scale)
+    assert np.allclose(r["moment"], rs["moment"], rtol=0, atol=1e-10 * scale)
+    assert bal["force"] < 1e-14 and bal["moment"] < 1e-3
+    assert bal["moment"] == pytest.approx(ser["moment"], rel=1e-4)

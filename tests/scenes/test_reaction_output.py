@@ -225,20 +225,27 @@ def test_restart_cuts_and_continues_the_reaction_series(tmp_path):
     assert sorted(p.name for p in (tmp_path / "parts").glob("reactions_*")) == [f for _, f in whole]
 
 
-def test_condensed_cantilever_rows_have_no_balance(scene_file, tmp_path):
+def test_condensed_cantilever_rows_have_the_balance(scene_file, tmp_path):
     """The statically condensed model reports the clamp's reaction from the section
-    resultants and no balance: its rows hold the reactions, NaN in the balance cells, and its
-    frames the reactions of results.json."""
+    resultants and its balance with the loads: its rows hold both (no NaN), and its frames
+    the reactions of results.json."""
     text = CANTILEVER.replace("KIN", "finite").replace("CONDENSE", "auto")
     out = tmp_path / "out"
     run = run_scene(scene_file(text), out, log=_quiet)
-    assert run["model"]["condensed"] and run["reaction_balance"] is None
+    assert run["model"]["condensed"]
     saved = json.loads((out / "results.json").read_text())
     rows = csv_rows(out)
     assert len(rows) == len(saved["path"]) == 2
     for row, point in zip(rows, saved["path"]):
         assert_row_equals(row, point["reactions"])
-        assert np.isnan(row["balance_force"]) and np.isnan(row["applied_f_x"])
+        assert not any(np.isnan(v) for v in row.values())
+        applied = [row[f"applied_f_{c}"] for c in "xyz"]  # λ F, dead: load factor 0.5, 1
+        assert np.allclose(applied, np.multiply(point["load_factor"], [1e3, -2e3, 5e3]))
+    bal = saved["reaction_balance"]
+    last = rows[-1]
+    assert np.allclose([last[f"applied_m_{c}"] for c in "xyz"], bal["applied_moment"])
+    assert last["balance_moment"] == pytest.approx(bal["moment"], rel=1e-11)
+    assert last["balance_force"] == pytest.approx(bal["force"], rel=1e-11, abs=1e-15)
     frames = pvd_frames(out / "reactions.pvd")
     assert len(frames) == 2
     assert_frame_equals(out, frames[-1][1], saved["reactions"])

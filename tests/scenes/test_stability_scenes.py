@@ -24,10 +24,10 @@ fix = "all"
 P_E = math.pi**2 * EI_Z / 4
 
 
-def _run(tmp_path, text):
+def _run(tmp_path, text, log=lambda *a: None):
     scene = tmp_path / "scene.toml"
     scene.write_text(text + f'\n[output]\ndir = "{tmp_path / "out"}"\n')
-    return run_scene(scene, log=lambda *a: None)
+    return run_scene(scene, log=log)
 
 
 def test_arclength_scene_switches_onto_the_buckled_branch(tmp_path):
@@ -45,8 +45,14 @@ max_arc_length = 0.05
 displacement_limit = ["uy", 0.3]
 """
     )
-    results = _run(tmp_path, text)
-    assert results["status"] == "converged" and results["stopped_by"] == "stop"
+    lines = []
+    results = _run(tmp_path, text, lines.append)
+    assert results["status"] == "converged" and results["stopped_by"] == "displacement_limit"
+    # the log names the cause: the value reached at the last point, past the limit
+    (line,) = [x for x in lines if x.startswith("stopped: displacement limit reached")]
+    uy = results["path"][-1]["displacement"][1]
+    assert f"uy of column:end = {uy:.6g}" in line and "past the limit |uy| = 0.3" in line
+    assert "does not land on it" in line
     (point,) = results["critical_points"]
     assert point["kind"] == "bifurcation" and point["switched"]
     assert point["negative_eigenvalues"] == [0, 1]

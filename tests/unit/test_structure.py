@@ -17,6 +17,7 @@ NOT_USERS = {
     "model",
     "condensed",
     "planar_condensed",
+    "condensed_reactions",  # the condensed model's reactions: reads its own members
     "discretisation",
     "formulation",
     "spec",
