@@ -313,21 +313,22 @@ def load_balance(reactions, applied, f_scale, m_scale, length):
 
 
 def condensed_reactions(model, evaluate, cache):
-    """``({support: Reaction}, Balance)`` of the statically condensed cantilever at its
-    current state (:mod:`~beamfx.analyses.condensed_reactions`): the section resultants at
-    the supports and their balance with the point loads, taken from the model's load data
-    at the current load factor, rotations and positions. ``evaluate(names)``: the probe
-    values of the points (collective); ``cache``: a dict kept across calls for the load
-    points' dofs. Collective."""
+    """``({support: Reaction}, Balance, gap)`` of the statically condensed cantilever at its
+    current state (:mod:`~beamfx.analyses.condensed_reactions`): the clamp's reaction (the
+    section force, the moment of the loads about it) and its balance with the point loads,
+    taken from the model's load data at the current load factor, rotations and positions;
+    ``gap``: |recovered section moment − that moment| over the moment scale.
+    ``evaluate(names)``: the probe values of the points (collective); ``cache``: a dict kept
+    across calls for the load points' dofs. Collective."""
     values = evaluate(condensed_parts.points(model))
-    out = {
-        at: Reaction(*parts)
-        for at, parts in condensed_parts.section_reactions(model, values).items()
-    }
     loads = condensed_parts.applied_loads(model, cache)
+    parts, recovered = condensed_parts.section_reactions(model, values, loads)
+    out = {at: Reaction(*p) for at, p in parts.items()}
     positions = {at: v["position"] for at, v in values.items()}
-    resultant = condensed_parts.load_resultant(loads, positions)
-    return out, load_balance(out, *resultant, model_size(model.spec))
+    applied, f_scale, m_scale = condensed_parts.load_resultant(loads, positions)
+    balance = load_balance(out, applied, f_scale, m_scale, model_size(model.spec))
+    gap = max((float(np.linalg.norm(recovered[at] - out[at].moment)) for at in out), default=0.0)
+    return out, balance, gap / max(m_scale, 1e-300) if gap else 0.0
 
 
 #: model -> its ReactionRecovery (forms compiled once), or for a model that is no
@@ -353,8 +354,12 @@ def entries(model):
         from ..io import evaluate_points
 
         evaluate = partial(evaluate_points, model, recover=False, full="sections")
-        reactions, balance = condensed_reactions(model, evaluate, recovery)
-        balance = {**balance._asdict(), "reactions_from": CONDENSED_SOURCE}
+        reactions, balance, gap = condensed_reactions(model, evaluate, recovery)
+        balance = {
+            **balance._asdict(),
+            "reactions_from": CONDENSED_SOURCE,
+            "recovered_moment_gap": gap,
+        }
     return {
         "reactions": {at: r._asdict() for at, r in reactions.items()},
         "reaction_balance": balance,
@@ -362,7 +367,9 @@ def entries(model):
 
 
 #: ``reaction_balance.reactions_from`` of the statically condensed model
-CONDENSED_SOURCE = "the section resultants at the clamp (statically condensed model)"
+CONDENSED_SOURCE = (
+    "the statics of the loads at their computed positions (statically condensed model)"
+)
 
 
 def balance_line(entry):
