@@ -165,8 +165,10 @@ def _stopper(path, comp, limit, stop):
         if comp is not None and abs(path[-1].displacement[comp]) >= abs(limit):
             stopped.append("displacement_limit")
             return True
-        stopped.append("stop")
-        return bool(stop is not None and stop(path))
+        if stop is not None and stop(path):
+            stopped.append("stop")
+            return True
+        return False
 
     return stop_here, stopped
 
