@@ -341,7 +341,7 @@ def solve_buckling(
     Kg.destroy()
     mu = pairs.values
     keep = _keep(mu, sign, n_modes, pairs.residuals)
-    for i in set(range(len(mu))) - set(keep):
+    for i in sorted(set(range(len(mu))) - set(keep)):  # (destroy is collective: one order)
         pairs.vectors[i].destroy()
     lam = float(model.load_factor.value)
     seconds = {

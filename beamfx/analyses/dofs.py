@@ -50,7 +50,8 @@ def point_displacement_dofs(model, at):
     """Owned local dofs of u_x, u_y, u_z at the named point ``at`` of a formulation with the
     mixed space ``model.W`` = (displacement, rotation): three arrays, each with one dof on the
     rank that owns the point and empty elsewhere (and empty for a planar model's out-of-plane
-    component, which is zero by construction).
+    component, which is zero by construction). Collective: DOLFINx exchanges the dofs found on
+    shared vertices, so all ranks must look up the same points in the same order.
 
     Raises:
         ValueError: if ``at`` is not a named point of the model.

@@ -19,8 +19,12 @@ def normalise(model, modes):
 
 
 def mode_report(model, probes, modes):
-    """Mode shapes (normalised) at the probes (``{name: point}``): their displacement."""
-    dofs = {at: point_displacement_dofs(model, at) for at in set(probes.values())}
+    """Mode shapes (normalised) at the probes (``{name: point}``): their displacement.
+
+    Each point is looked up once, in the probes' order: the lookup is collective (DOLFINx
+    exchanges the dofs found on shared vertices), so every rank must ask for the same points
+    in the same order, which a ``set``'s (string hashes differ between processes) is not."""
+    dofs = {at: point_displacement_dofs(model, at) for at in dict.fromkeys(probes.values())}
     return tuple(
         {
             name: point_displacement(model, dofs[at], mode.x.array).tolist()
