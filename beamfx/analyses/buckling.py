@@ -36,6 +36,7 @@ from typing import NamedTuple
 import numpy as np
 import ufl
 
+from ..geometry.mesh import mesh_size
 from ..physics import coupled, energy, mixed
 from ..physics.kinematics import strains
 from ..solvers.eigen import solve_eigen
@@ -250,8 +251,7 @@ def _scaled_max(model, f):
     """The largest of |u| / model size and |rotation components| over the dofs. Collective."""
     from mpi4py import MPI
 
-    x = model.mesh.mesh.geometry.x
-    size = model.comm.allreduce(np.ptp(x, axis=0).max() if len(x) else 0.0, op=MPI.MAX)
+    size = mesh_size(model.mesh.mesh)  # the whole model's, not this rank's part's
     local = 0.0
     for sub, scale in ((0, 1.0 / max(size, 1e-300)), (1, 1.0)):
         dofs = subspace_dofs(model.W, sub)

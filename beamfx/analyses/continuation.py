@@ -13,6 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..geometry.mesh import mesh_size
 from ..solvers.arclength import ArcLengthSettings, ArcLengthSolver
 from ..solvers.forms import compile_seconds
 from ..spec import DOF_NAMES
@@ -242,12 +243,8 @@ def geometric_arc_length(model, u_dofs):
 
 
 def model_size(model):
-    """The largest extent of the model's mesh along x, y or z (collective)."""
-    from mpi4py import MPI
-
-    x = model.mesh.mesh.geometry.x
-    local = float(np.ptp(x, axis=0).max()) if len(x) else 0.0
-    return model.comm.allreduce(local, op=MPI.MAX)
+    """The largest extent of the model's mesh along x, y or z, over all ranks (collective)."""
+    return mesh_size(model.mesh.mesh)
 
 
 def limit_in_step(path, step, load_factor):

@@ -4,6 +4,7 @@ the probes, and written as one ParaView frame per mode."""
 import numpy as np
 from mpi4py import MPI
 
+from ..geometry.mesh import mesh_size
 from .dofs import point_displacement, point_displacement_dofs, subspace_dofs
 
 PARAVIEW_STEPS = "one per mode (time = mode number), displacement scaled to 1/10 of the model size"
@@ -37,8 +38,7 @@ def mode_report(model, probes, modes):
 def write_modes(model, modes, frames):
     """One frame per mode (time = mode number): the state plus the (normalised) mode, scaled
     to a tenth of the model's size."""
-    x = model.mesh.mesh.geometry.x
-    size = model.comm.allreduce(float(np.ptp(x, axis=0).max()) if len(x) else 0.0, op=MPI.MAX)
+    size = mesh_size(model.mesh.mesh)  # the whole model's, not this rank's part's
     w0 = model.w.x.array.copy()
     for i, mode in enumerate(modes, start=1):
         model.w.x.array[:] = w0 + 0.1 * size * mode.x.array

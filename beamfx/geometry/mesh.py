@@ -84,6 +84,24 @@ def tolerance(specs):
     return 1e-9 * size
 
 
+def mesh_size(mesh):
+    """The model's size: the largest extent along x, y or z of the nodes of the (distributed)
+    DOLFINx ``mesh`` over all ranks, the same on every rank. Collective.
+
+    Each rank holds a part of the mesh (its cells and ghosts), so the box of its own nodes is
+    not the model's: the bounds are reduced over the ranks before the extent is taken.
+    """
+    from mpi4py import MPI
+
+    x = mesh.geometry.x
+    bounds = np.full(6, -np.inf)  # (−min, max) per axis: one reduction with MAX
+    if len(x):
+        bounds = np.r_[-x.min(axis=0), x.max(axis=0)]
+    mesh.comm.Allreduce(MPI.IN_PLACE, bounds, op=MPI.MAX)
+    extent = bounds[3:] + bounds[:3]
+    return float(extent.max()) if np.isfinite(extent).all() else 0.0
+
+
 def overlapping_cells(specs, tol=None, breaks=None):
     """(index of the spec, why) if the element vertices of ``specs`` would make a broken
     mesh, or None.

@@ -95,3 +95,43 @@ def test_mode_report_independent_of_set_order(modal, monkeypatch):
     # the first bending mode: the tip moves most (1 after normalising), the middle a third
     assert abs(report[0]["tip"][1]) == pytest.approx(1.0, abs=1e-9)
     assert abs(report[0]["mid"][1]) == pytest.approx(0.3396, abs=1e-3)
+
+
+class _Recorder:
+    """Frames of :func:`~beamfx.analyses.mode_shapes.write_modes`: the largest displacement
+    of each (over all ranks), in place of a ParaView file."""
+
+    def __init__(self, model):
+        from beamfx.analyses.dofs import subspace_dofs
+
+        self.model, self.u_dofs, self.largest = model, subspace_dofs(model.W, 0), []
+
+    def write(self, step, time):
+        local = np.abs(self.model.w.x.array[self.u_dofs]).max(initial=0.0)
+        self.largest.append(self.model.comm.allreduce(local, op=MPI.MAX))
+
+
+def test_mode_frames_scaled_to_the_whole_model(modal):
+    """Each mode's frame moves the model by a tenth of its size (1 m), not of a rank's part."""
+    from beamfx.analyses.mode_shapes import write_modes
+
+    model, modes = modal
+    frames = _Recorder(model)
+    write_modes(model, modes, frames)
+    assert np.allclose(frames.largest, 0.1, rtol=1e-12), frames.largest
+
+
+def test_model_size_is_global(modal):
+    """The model's size of the arc-length defaults and of buckling's difference step: the
+    whole cantilever's length on every rank."""
+    from beamfx.analyses.buckling import _scaled_max
+    from beamfx.analyses.continuation import model_size
+    from beamfx.analyses.dofs import subspace_dofs
+    from beamfx.geometry.mesh import mesh_size
+
+    model, modes = modal
+    assert mesh_size(model.mesh.mesh) == pytest.approx(1.0, rel=1e-12)
+    assert model_size(model) == pytest.approx(1.0, rel=1e-12)
+    u_only = modes[0].copy()  # largest |u| 1 (normalised), no rotation: |u| / size = 1
+    u_only.x.array[subspace_dofs(model.W, 1)] = 0.0
+    assert _scaled_max(model, u_only) == pytest.approx(1.0, rel=1e-12)
