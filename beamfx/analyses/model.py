@@ -176,15 +176,20 @@ class BeamModel(Discretised):
         the weight of an offset mass centre. A point mass ``[[masses]]`` has its centre of
         mass at its point (its ``inertia`` is about that point): its weight m g acts there as
         a dead force, m g·δu; its rotary inertia weighs nothing more and has no moment arm."""
+        from dolfinx import fem
+        from petsc4py import PETSc
+
         spec, kin, d = self.spec, self.kin, self.discretisation
-        g = ufl.as_vector([float(c) for c in spec.gravity])
+        g_xyz = [float(c) for c in spec.gravity]
+        g = ufl.as_vector(g_xyz)
         work = d.inertia[0] * ufl.dot(g, displacement(kin, v_u)) * d.dx
         if d.matrices is not None:  # the moment of the weight of an offset mass centre
             work += coupled.gravity_moment_work(kin, rot, v_rot, d.Lam0, d.matrices.M, g) * d.dx
         for pm in spec.point_masses:
-            if pm.mass > 0:
-                weight = float(pm.mass) * ufl.dot(g, displacement(kin, v_u))
-                work += d.at_point(pm.at, weight, cell_exact=True)
+            if pm.mass > 0:  # m g a constant of the form, as a point load's force
+                mg = np.asarray(g_xyz, dtype=PETSc.ScalarType) * pm.mass
+                weight = fem.Constant(self.mesh.mesh, mg)
+                work += d.at_point(pm.at, ufl.dot(weight, displacement(kin, v_u)), cell_exact=True)
         return work
 
     def _joint_work(self, loads, axes, v_u, v_rot):
