@@ -12,12 +12,19 @@
 # As the seed verifies its solutions, we check equilibrium along the span: at every section
 # the internal moment from the constitutive law against the moment of the load beyond it
 # (beamfx.bench.span_equilibrium).
+#
+# Run `python demos/blade_prebend.py [--out DIR]`: it writes the figure of the moments along the
+# span (docs/images/blade_prebend_moments.png is a copy) into results/blade_prebend/ under the
+# current folder, or DIR (or $BEAMFX_DEMO_OUT/blade_prebend: the tests set it to a temporary one).
 
+import os
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from mpi4py import MPI
 
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.static import solve_static
@@ -26,6 +33,10 @@ from beamfx.io import evaluate_points, log
 from beamfx.scene import load_scene
 
 HERE = Path(__file__).resolve().parent
+argv = sys.argv[1:] if __name__ == "__main__" else []
+OUT = Path(argv[argv.index("--out") + 1]) if "--out" in argv else None
+OUT = OUT or Path(os.environ.get("BEAMFX_DEMO_OUT", "results")) / "blade_prebend"
+OUT = Path(MPI.COMM_WORLD.bcast(str(OUT), root=0))
 scene = load_scene(HERE.parent / "meshes" / "nrel5mw_blade" / "blade_prebend.toml")
 spec = scene.model
 load = spec.distributed_loads[0]
@@ -81,7 +92,7 @@ log(f"demo time {time.perf_counter() - t0:.0f} s")
 assert abs(tips["a", 4][2]) < 1e-3 and tips["b", 4][2] < -10.0
 assert max(mismatch(m) for m in curves.values()) < 1e-4
 
-if __name__ == "__main__":
+if __name__ == "__main__" and MPI.COMM_WORLD.rank == 0:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -98,6 +109,6 @@ if __name__ == "__main__":
         ax.set_ylabel("moment (MN m, section axes)")
         ax.grid(alpha=0.3)
     axs[0].legend(fontsize=7)
-    out = HERE.parent / "docs" / "validation" / "blade_prebend.png"
-    fig.savefig(out, dpi=110)
-    log(f"wrote {out}")
+    OUT.mkdir(parents=True, exist_ok=True)
+    fig.savefig(OUT / "blade_prebend_moments.png", dpi=110)
+    log(f"wrote {OUT / 'blade_prebend_moments.png'}")

@@ -15,10 +15,12 @@
 # Run `python demos/pai_beam.py --full [--out DIR]` for the sweeps of docs/pai_beam.md (six
 # sweeps of 40–160 s of motion, about 6–8 minutes on a quiet core); without `--full` (as
 # the tests run it) the sweeps are short and narrow and only the qualitative checks are made.
+# It writes pai_beam_sweep.csv and .png into results/pai_beam/ (results/pai_beam_short/
+# without `--full`) under the current folder, or DIR (or $BEAMFX_DEMO_OUT/<that name>: the
+# tests set it to a temporary one).
 
 import os
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -30,13 +32,12 @@ from beamfx.io import log
 
 argv = sys.argv[1:] if __name__ == "__main__" else []
 FULL = "--full" in argv or os.environ.get("BEAMFX_DEMO_FULL") == "1"
-if "--out" in argv:
-    OUT = Path(argv[argv.index("--out") + 1])
-elif FULL:
-    OUT = Path("pai_beam_results")
-else:
-    OUT = Path(tempfile.mkdtemp(prefix="pai_beam_"))
+OUT = Path(argv[argv.index("--out") + 1]) if "--out" in argv else None
+NAME = "pai_beam" if FULL else "pai_beam_short"
+OUT = OUT or Path(os.environ.get("BEAMFX_DEMO_OUT", "results")) / NAME
+OUT = Path(MPI.COMM_WORLD.bcast(str(OUT), root=0))
 rank0 = MPI.COMM_WORLD.rank == 0
+log(f"pai_beam demo: writes into {OUT}")
 
 # ## Linear frequencies about the gravity-loaded state
 # The beam's weight (0.48 N) compresses it at 28 % of its self-weight buckling load, which

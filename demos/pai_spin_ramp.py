@@ -12,10 +12,12 @@
 # core), the figure pai_spin_ramp.png and tip_history.csv (the tip in the inertial and the
 # rotating frame, and its twist, against time). Without `--full` (as the tests run it) a
 # sparse sweep on one mesh and the first 0.2 s of the spin ramp on 4 elements at dt = 10 ms.
+# The runs' folders (and with `--full` the figure and the CSV) go into results/pai_spin_ramp/
+# (results/pai_spin_ramp_short/ without `--full`) under the current folder, or DIR (or
+# $BEAMFX_DEMO_OUT/<that name>: the tests set it to a temporary one).
 
 import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -29,9 +31,11 @@ from beamfx.runner import run_scene
 argv = sys.argv[1:] if __name__ == "__main__" else []
 FULL = "--full" in argv or os.environ.get("BEAMFX_DEMO_FULL") == "1"
 OUT = Path(argv[argv.index("--out") + 1]) if "--out" in argv else None
-OUT = OUT or Path("pai_spin_ramp_results" if FULL else tempfile.mkdtemp(prefix="pai_spin_"))
+NAME = "pai_spin_ramp" if FULL else "pai_spin_ramp_short"
+OUT = OUT or Path(os.environ.get("BEAMFX_DEMO_OUT", "results")) / NAME
 comm = MPI.COMM_WORLD
 OUT = Path(comm.bcast(str(OUT), root=0))
+log(f"pai_spin_ramp demo: writes into {OUT}")
 SCENE = Path(ps.__file__).parents[1] / "scenes" / "pai_spin_ramp.toml"
 quiet = lambda *a, **k: None
 
@@ -179,3 +183,4 @@ if FULL:
             header="time,spin_hz,x,y,z,x_rotating,y_rotating,z_rotating,twist_rad",
             comments="",
         )
+        log(f"wrote {OUT / 'pai_spin_ramp.png'} and {OUT / 'tip_history.csv'}")

@@ -11,10 +11,12 @@
 # The scene is the shipped `beamfx/scenes/shallow_arch_snap.toml`: the load is given in the
 # section axes of the undeformed arch (`axes = "section"`), so it points to the centre of the
 # arc everywhere; the arch has an `orientation` normal to its plane, and beamfx runs the
-# planar model. Run `python demos/shallow_arch.py [--out DIR]`.
+# planar model. Run `python demos/shallow_arch.py [--out DIR]`: the three runs' folders go into
+# results/shallow_arch/ under the current folder, or DIR (or $BEAMFX_DEMO_OUT/shallow_arch: the
+# tests set it to a temporary one); each run clears its folder's results of the last one.
 
+import os
 import sys
-import tempfile
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -29,10 +31,11 @@ from beamfx.scene.load import parse_scene
 
 argv = sys.argv[1:] if __name__ == "__main__" else []
 OUT = Path(argv[argv.index("--out") + 1]) if "--out" in argv else None
+OUT = OUT or Path(os.environ.get("BEAMFX_DEMO_OUT", "results")) / "shallow_arch"
 comm = MPI.COMM_WORLD
-if OUT is None:
-    OUT = Path(comm.bcast(tempfile.mkdtemp(prefix="shallow_arch_") if comm.rank == 0 else None))
+OUT = Path(comm.bcast(str(OUT), root=0))
 rank0 = comm.rank == 0
+log(f"shallow_arch demo: writes into {OUT}")
 TEXT = resources.files("beamfx.scenes").joinpath("shallow_arch_snap.toml").read_text()
 
 

@@ -161,11 +161,7 @@ class BeamModel(Discretised):
                 on_beam = d.beam_profile(names.index(dl.beam), dl.profile)
             work += self._time_factor(dl.history) * on_beam * work_of(dl) * d.dx
         if any(spec.gravity):
-            rho_A = d.inertia[0]
-            work += rho_A * ufl.dot(vec(spec.gravity), displacement(kin, v_u)) * d.dx
-            if d.matrices is not None:  # the moment of the weight of an offset mass centre
-                g = vec(spec.gravity)
-                work += coupled.gravity_moment_work(kin, rot, v_rot, d.Lam0, d.matrices.M, g) * d.dx
+            work += self._gravity_work(rot, v_u, v_rot)
         self.Pi = Pi
         self.F = ufl.derivative(Pi, self.w, test)
         self.work = None  # virtual work of the loads at load factor 1 (None: no loads)
@@ -173,6 +169,28 @@ class BeamModel(Discretised):
             self.work = work
             self.F -= self.load_factor * work
         self.J = ufl.derivative(self.F, self.w, ufl.TrialFunction(self.W))
+
+    def _gravity_work(self, rot, v_u, v_rot):
+        """Virtual work of the weight (gravity ``spec.gravity``, nonzero) of the beams and of
+        the point masses. Beams: ρA g·δu per length, and with matrix sections the moment of
+        the weight of an offset mass centre. A point mass ``[[masses]]`` has its centre of
+        mass at its point (its ``inertia`` is about that point): its weight m g acts there as
+        a dead force, m g·δu; its rotary inertia weighs nothing more and has no moment arm."""
+        from dolfinx import fem
+        from petsc4py import PETSc
+
+        spec, kin, d = self.spec, self.kin, self.discretisation
+        g_xyz = [float(c) for c in spec.gravity]
+        g = ufl.as_vector(g_xyz)
+        work = d.inertia[0] * ufl.dot(g, displacement(kin, v_u)) * d.dx
+        if d.matrices is not None:  # the moment of the weight of an offset mass centre
+            work += coupled.gravity_moment_work(kin, rot, v_rot, d.Lam0, d.matrices.M, g) * d.dx
+        for pm in spec.point_masses:
+            if pm.mass > 0:  # m g a constant of the form, as a point load's force
+                mg = np.asarray(g_xyz, dtype=PETSc.ScalarType) * pm.mass
+                weight = fem.Constant(self.mesh.mesh, mg)
+                work += d.at_point(pm.at, ufl.dot(weight, displacement(kin, v_u)), cell_exact=True)
+        return work
 
     def _joint_work(self, loads, axes, v_u, v_rot):
         """Virtual work (a form) of dead point ``loads`` at joints where more than two elements
