@@ -11,7 +11,8 @@ PARAVIEW_STEPS = "one per mode (time = mode number), displacement scaled to 1/10
 
 
 def normalise(model, modes):
-    """Scale each mode (in place) so that its largest nodal displacement is 1."""
+    """Scale each mode (in place) so that its largest nodal displacement component (in
+    absolute value; not the largest length of u) is 1."""
     u_dofs = subspace_dofs(model.W, 0)
     for mode in modes:
         local = np.max(np.abs(mode.x.array[u_dofs]), initial=0.0)
