@@ -13,7 +13,6 @@ from typing import NamedTuple
 
 from ..solvers import NewtonSolver
 from ..solvers.integrators import generalized_alpha, hht, newmark
-from ..solvers.snes import SolveFailed
 from ..solvers.step_control import EasyGrowth, ErrorBased, StepControl, StepTooSmall
 from .checks import model_size
 from .conserving import Projection
@@ -29,6 +28,7 @@ from .transient_checkpoint import (
     restore_control,
     restore_state,
 )
+from .transient_failure import TransientFailed, step_failure
 
 __all__ = [
     "CHECKPOINT_SECONDS",
@@ -110,10 +110,6 @@ class TransientResult(NamedTuple):
     stopped_by: str  # "t_end" or the reason of a failure
 
 
-class TransientFailed(SolveFailed):
-    """A time step that Newton could not take even at the smallest step size."""
-
-
 def _begin(saved, dyn, balance, control, on_step, log):
     """(t, step) to march from: the checkpoint ``saved``, else t = 0 at rest (recorded)."""
     model = dyn.model
@@ -146,13 +142,15 @@ class _March(NamedTuple):
     reactions: object = None  # called at each converged step (transient_reactions.py)
 
 
-def _step(m, control, t, failed):
-    """Newton from ``t`` at the control's step size, cut back until a step is accepted:
-    (h, the size wanted before the end time shortened it, report, cut-backs, error estimate or
-    None); ``model.w`` then holds q_{n+1}.
+def _step(m, control, t, step, failed):
+    """Newton from ``t`` (after ``step`` accepted steps) at the control's step size, cut back
+    until a step is accepted: (h, the size wanted before the end time shortened it, report,
+    cut-backs, error estimate or None); ``model.w`` then holds q_{n+1}.
 
     Raises:
-        TransientFailed: below the smallest step size, after ``failed()`` (the checkpoint).
+        TransientFailed: after a failure at the smallest step size (``dt_min`` is tried
+            last), after ``failed()`` (the checkpoint); with the cause, the remedy and every
+            attempt (:func:`~beamfx.analyses.transient_failure.step_failure`).
     """
     s, model, dyn = m.settings, m.model, m.dyn
     wanted = control.size  # kept if only the end time shortens this step
@@ -164,22 +162,21 @@ def _step(m, control, t, failed):
             error = dyn.error_estimate(h, s.tolerance, m.length)
             if error <= 1.0 or h <= m.dt_min * (1 + 1e-9):
                 return h, wanted, report, cutbacks, error
-            reason_ = f"local error {error:.3g} x tolerance"
-            tried.append((h, reason_, report.residuals))
+            tried.append((h, report, f"local error {error:.3g} x tolerance"))
             model.w.x.array[:] = dyn.q_n.x.array
             h, cutbacks = control.rejected(error), cutbacks + 1
             continue
         if report.converged:
             return h, wanted, report, cutbacks, error
-        tried.append((h, report.reason, report.residuals))
+        tried.append((h, report, report.reason))
         model.w.x.array[:] = dyn.q_n.x.array
         cutbacks += 1
         try:
-            h = control.rejected()
+            h_failed, h = h, control.rejected()
         except StepTooSmall:
             failed()
-            raise TransientFailed(_failure(t, m.dt_min, tried)) from None
-        m.log(f"  t = {t:.6g}: {report.reason} with dt = {2 * h:.3g}; retrying with {h:.3g}")
+            raise step_failure(t, step, m.dt_min, tried) from None
+        m.log(f"  t = {t:.6g}: {report.reason} with dt = {h_failed:.3g}; retrying with {h:.3g}")
 
 
 def _newton(m, t, h):
@@ -274,7 +271,7 @@ def solve_transient(
     m, compile_time = _march(model, s, options, prefix, log, reactions)
     dyn, balance, solver = m.dyn, m.balance, m.solver
     growth = ErrorBased() if s.tolerance else EasyGrowth(1.5, s.easy_iterations, 2, clean=True)
-    control = StepControl(s.dt, s.dt, m.dt_min, growth)
+    control = StepControl(s.dt, s.dt, m.dt_min, growth, reach_smallest=True)
 
     def save(t, step):
         if checkpoint:
@@ -289,7 +286,7 @@ def solve_transient(
     q_old = model.w.x.array.copy()
     while t < s.t_end * (1 - 1e-12):
         h, wanted, report, cutbacks, error = _step(
-            m, control, t, lambda t=t, step=step: save(t, step)
+            m, control, t, step, lambda t=t, step=step: save(t, step)
         )
         energy = _accept(m, t, h, q_old, step + 1)
         t, step, iterations = t + h, step + 1, iterations + report.iterations
@@ -313,15 +310,3 @@ def solve_transient(
     seconds = {"compile": compile_time, **solver.seconds, "total": time.perf_counter() - t_start}
     solver.destroy()
     return TransientResult(tuple(records), iterations, seconds, stopped_by)
-
-
-def _failure(t, dt_min, tried):
-    """The message of a step that failed at every size: each try and its residuals."""
-    lines = [
-        f"  dt = {dt:.3g}: {why}, residuals {', '.join(f'{r:.3e}' for r in res)}"
-        for dt, why, res in tried
-    ]
-    return (
-        f"time step from t = {t:.6g} failed at every step size down to "
-        f"dt_min = {dt_min:.3g}:\n" + "\n".join(lines)
-    )

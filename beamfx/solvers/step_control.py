@@ -81,12 +81,15 @@ class StepControl:
         smallest: a halving below this raises :class:`StepTooSmall`; an error-based cut-back
             stops at it (the step is then taken).
         growth: the policy after an accepted step.
+        reach_smallest: a halving that would go below ``smallest`` from a larger size tries
+            ``smallest`` itself first (so the smallest step allowed is the last one tried).
     """
 
     size: float
     largest: float
     smallest: float
     growth: object
+    reach_smallest: bool = False
 
     def accepted(self, iterations, cutbacks=0, error=None):
         """Size the next step after one accepted with ``iterations`` Newton iterations after
@@ -101,9 +104,12 @@ class StepControl:
         if error is not None:
             self.size = max(self.size * self.growth.shrink(error), self.smallest)
             return self.size
+        above = self.size > self.smallest * (1 + 1e-12)
         self.size /= 2
         if self.size < self.smallest:
-            raise StepTooSmall(self.size)
+            if not (self.reach_smallest and above):
+                raise StepTooSmall(self.size)
+            self.size = self.smallest
         return self.size
 
 

@@ -116,17 +116,26 @@ def step_load(
     return history
 
 
-def _remedy(last, sizes, steps):
-    """The remedy of the ``last`` attempt of a step tried at the load increments ``sizes``:
-    more iterations if ``[solver] snes_max_it`` stopped Newton below PETSc's default; not a
-    smaller step if the cut-backs went down to a hundredth of the first try and failed the
-    same way; else the cause's own (:func:`~beamfx.solvers.convergence.remedy`)."""
+def iteration_limit(last):
+    """The remedy "more iterations" if ``[solver] snes_max_it`` stopped the ``last`` attempt
+    (a SolveReport) below PETSc's default number of iterations, else None."""
     default = DEFAULT_OPTIONS["snes_max_it"]
     if last.reason == "DIVERGED_MAX_IT" and last.iterations < default:
         return (
             f"more iterations: [solver] snes_max_it = {last.iterations} stops Newton before "
             f"it converges (the default is {default})"
         )
+    return None
+
+
+def _remedy(last, sizes, steps):
+    """The remedy of the ``last`` attempt of a step tried at the load increments ``sizes``:
+    more iterations if ``[solver] snes_max_it`` stopped Newton below PETSc's default; not a
+    smaller step if the cut-backs went down to a hundredth of the first try and failed the
+    same way; else the cause's own (:func:`~beamfx.solvers.convergence.remedy`)."""
+    limit = iteration_limit(last)
+    if limit:
+        return limit
     if last.cause in STEP_CAUSES and len(sizes) > 1 and min(sizes) <= 1e-2 * sizes[0]:
         return (
             f"not a smaller step: cut back to {min(sizes) / sizes[0]:.1e} of the first try, "

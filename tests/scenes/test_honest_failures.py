@@ -203,6 +203,65 @@ def test_a_numerical_newton_failure_of_a_rotating_run_is_failed_not_stopped(tmp_
     assert "stays positive definite" in results["failure"]["tangent"]
 
 
+SUDDEN = """
+[material]
+E = 2.1e11
+nu = 0.3
+rho = 7850
+
+[[beams]]
+name = "b"
+curve = { shape = "line", start = [0, 0, 0], end = [1, 0, 0] }
+section = { type = "rectangle", h = 0.01, w = 0.01 }
+elements = 8
+degree = 2
+
+[[supports]]
+at = "b:start"
+fix = "all"
+
+[[loads]]
+at = "b:end"
+force = [0, 0, 5000]
+moment = [0, 500, 0]
+
+[analysis]
+type = "transient"
+dt = 10
+t_end = 100
+
+[[probes]]
+name = "tip"
+at = "b:end"
+"""
+
+
+def test_a_failed_time_step_reports_cause_remedy_and_attempts(tmp_path, capsys):
+    """A sudden 5000 N on a 1 x 1 cm steel cantilever at dt = 10: no step size Newton can
+    take from t = 0. results.json had only a reason ending in a colon (the residual lines
+    lost) and said "down to dt_min = 0.01" when 0.0195 was the smallest tried; now it has the
+    cause, the remedy (smaller steps: the inertia dominates a short step), every attempt with
+    its residuals, the time and step, and dt_min itself is the last size tried."""
+    code, results, captured = run(tmp_path, SUDDEN, capsys)
+    assert_failed(code, results, captured, results["cause"])
+    assert results["cause"] in REMEDIES and results["cause"] != "other"
+    assert results["remedy"].startswith("smaller time steps: the smallest tried, dt = 0.01,")
+    assert not results["reason"].endswith(":") and "from t = 0 " in results["reason"]
+    failure = results["failure"]
+    assert failure["time"] == 0.0 and failure["step"] == 1 and failure["dt_min"] == 0.01
+    attempts = failure["attempts"]
+    sizes = [a["dt"] for a in attempts]
+    assert sizes[0] == 10.0 and sizes[-2] == pytest.approx(10 / 2**9) and sizes[-1] == 0.01
+    assert failure["smallest_dt_tried"] == 0.01
+    for a in attempts:  # each attempt's residual history, from the load's first residual
+        assert a["reason"].startswith("DIVERGED") and a["cause"] in REMEDIES
+        assert len(a["residuals"]) == a["iterations"] + 1 and a["residuals"][0] > 0
+    if MPI.COMM_WORLD.rank == 0:
+        last = captured.err.strip().splitlines()[-1]
+        assert last.startswith("beamfx: failed: time step 1 from t = 0 ")
+        assert "cause: " in last and "remedy: smaller time steps" in last
+
+
 FRAME = """
 [material]
 E = {E!r}

@@ -43,3 +43,20 @@ def test_error_based_sizes_both_ways_and_stops_at_smallest():
     assert c.rejected(error=1e6) == pytest.approx(0.001)  # floor 0.2, then smallest
     assert c.accepted(3, error=1e-12) == pytest.approx(0.002)  # at most doubled
     assert c.accepted(3, error=1.0) == pytest.approx(0.0018)
+
+
+def test_a_halving_past_the_smallest_step_tries_the_smallest_itself_first():
+    """With reach_smallest (the time steps'), 10 -> ... -> 0.0195 -> 0.01 (dt_min), then
+    StepTooSmall: the smallest step allowed is the last one tried (it stopped at 0.0195 and
+    the failure said "down to dt_min = 0.01")."""
+    c = StepControl(10.0, 10.0, 0.01, EasyGrowth(), reach_smallest=True)
+    sizes = [c.size]
+    with pytest.raises(StepTooSmall):
+        while True:
+            sizes.append(c.rejected())
+    assert sizes[-2] == pytest.approx(10.0 / 2**9) and sizes[-1] == 0.01
+    assert len(sizes) == 11
+    exact = StepControl(0.08, 0.08, 0.01, EasyGrowth(), reach_smallest=True)
+    assert [exact.rejected(), exact.rejected(), exact.rejected()] == [0.04, 0.02, 0.01]
+    with pytest.raises(StepTooSmall):  # a halving that lands on it: no second try
+        exact.rejected()
