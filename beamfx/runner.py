@@ -117,6 +117,10 @@ def run_scene(
     if restart and not analysis(scene.analysis).restart:
         log(f"note: a {scene.analysis} analysis has no checkpoint to go on from: a fresh run")
         restart = False
+    if restart:  # checkpoints of another number of ranks only: refused, nothing touched
+        from .analyses.restart import refuse_other_ranks
+
+        refuse_other_ranks(out, comm)
     with claim(out, comm, path, restart, log):  # locked, an earlier run's files removed
         linear_solvers(reset=True)  # those of this run only
         scene, refinement = _refine(scene, comm, log)

@@ -8,9 +8,18 @@ file and the ranks agree: a missing or damaged file, another scene (its differen
 or another mesh stop every rank with one message, before anything is solved.
 """
 
+import os
+import re
+
 import numpy as np
 
-from ..io.checkpoint import agree, checkpoint_path, read_checkpoints, write_checkpoint
+from ..io.checkpoint import (
+    CheckpointError,
+    agree,
+    checkpoint_path,
+    read_checkpoints,
+    write_checkpoint,
+)
 from ..io.fingerprint import mesh_differences, mesh_fingerprint, scene_differences
 from ..io.fingerprint import scene_fingerprint as _scene_fingerprint
 from .dofs import owned_size
@@ -42,6 +51,62 @@ def checkpoint_writer(ctx, settings, model, history):
         write_checkpoint(path, {**full, "ranks": ctx.comm.size, "rank": ctx.comm.rank}, arrays)
 
     return write
+
+
+#: the name of a checkpoint file (:func:`~beamfx.io.checkpoint.checkpoint_path`)
+_CHECKPOINT = re.compile(r"checkpoint_(\d+)ranks_(\d+)\.npz")
+
+
+def checkpoint_ranks(folder):
+    """{number of ranks: [file names]} of the checkpoints in ``folder`` (none if missing)."""
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return {}
+    found = {}
+    for name in names:
+        match = _CHECKPOINT.fullmatch(name)
+        if match:
+            found.setdefault(int(match[1]), []).append(name)
+    return found
+
+
+def refuse_other_ranks(folder, comm):
+    """Refuse (on every rank) a ``--restart`` in ``folder`` whose checkpoints were all
+    written by runs on another number of ranks: a run from t = 0 would replace that run's
+    files. Called before the folder is claimed or any file written (collective).
+
+    Raises:
+        CheckpointError: naming the folder, the ranks the checkpoints are for and what to do.
+    """
+    found = checkpoint_ranks(folder) if comm.rank == 0 else None
+    found = comm.bcast(found) if comm.size > 1 else found
+    if not found or comm.size in found:
+        return
+    raise CheckpointError(_other_ranks_message(folder, found, comm.size))
+
+
+def _ranks(n):
+    return f"{n} rank{'s' if n > 1 else ''}"
+
+
+def _other_ranks_message(folder, found, size):
+    """The refusal of :func:`refuse_other_ranks`: ``found`` {ranks: file names}."""
+    counts = sorted(found)
+    names = [name for n in counts for name in found[n]]
+    files = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+    how = " or ".join(
+        "one rank (beamfx run ... --restart, without mpirun)"
+        if n == 1
+        else f"{n} ranks (mpirun -n {n} beamfx run ... --restart)"
+        for n in counts
+    )
+    return (
+        f"{folder}: cannot --restart on {_ranks(size)}: its checkpoints were written by a run "
+        f"on {' or '.join(_ranks(n) for n in counts)} ({files}). Restart on {how} to go on "
+        "from them, or run without --restart to start afresh (which replaces that run's "
+        "files). Nothing in the folder was changed."
+    )
 
 
 def load_restart(ctx, settings, model):

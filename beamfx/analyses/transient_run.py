@@ -190,8 +190,8 @@ def _start(model, settings, ctx):
     saved = load_restart(ctx, settings, model) if ctx.restart else None
     if ctx.restart and ctx.comm.rank == 0:  # accepted: the earlier run's results go
         (ctx.folder / "results.json").unlink(missing_ok=True)
-    if ctx.restart and saved is None:
-        ctx.log("note: no checkpoint for this number of ranks; starting from t = 0")
+    if ctx.restart and saved is None:  # (those of other ranks only: refused before)
+        ctx.log(f"note: no checkpoint in {ctx.folder}; starting from t = 0")
     if saved is None and settings.start == "static":
         from .static import solve_static
 
