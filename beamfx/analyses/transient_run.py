@@ -200,7 +200,9 @@ def _start(model, settings, ctx):
         static = solve_static(model, steps=settings.steps, options=opts, log=ctx.log)
         ctx.log(f"static start: {static.newton_iterations} Newton iterations")
     if saved is not None:
-        ctx.frames.resume(saved[0]["t"], saved[0]["step"])
+        note = ctx.frames.resume(saved[0]["t"], saved[0]["step"])
+        if note:
+            ctx.log(note)
     return saved
 
 

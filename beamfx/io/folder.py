@@ -33,6 +33,7 @@ SYSTEM_FOLDERS = (
 RUN_FILES = re.compile(
     r"(results\.json|probes\.csv|probes\.jsonl|reactions\.csv|path\.csv|open_in_paraview\.py"
     r"|(deformed|surface)(_\d{4,}(_\d+)?\.(vtu|pvtu)|\.pvd|\.xdmf|\.h5)"
+    r"|deformed\.(part\d+\.h5|before_restart\.(xdmf|h5))"
     r"|reactions(_\d{4,}\.vtu|\.pvd)"
     r"|undeformed\.vtu|deformed\.png|mode_\d+\.png|animation\.gif"
     r"|checkpoint_\d+ranks_\d+\.npz|\.checkpoint_\d+ranks_\d+\.\d+\.tmp\.npz|\.tmp-.*\.json)"

@@ -263,14 +263,15 @@ class FrameWriter:
         """Keep the frames up to ``t_max`` of an earlier run in the folder (a restart) and
         drop later ones with their files. ``step``: the step at ``t_max`` (a checkpoint's);
         its frame, written where the earlier run stopped, is dropped too unless ``every``
-        asks for that step, so that the series goes on as an uninterrupted run's."""
+        asks for that step, so that the series goes on as an uninterrupted run's. Returns a
+        note for the log (XDMF: :meth:`~beamfx.io.xdmf.XdmfSeries.resume`), or None."""
         policy = self.policy
         inclusive = step is None or policy.by_time or step % policy.every == 0
         for series in self._all_series():
             series.resume(t_max, inclusive)
-        if self.xdmf is not None:
-            self.xdmf.resume(t_max)
+        note = self.xdmf.resume(t_max, inclusive) if self.xdmf is not None else None
         self.policy.resume(t_max)
+        return note
 
     def close(self):
         """Close the files that stay open (the series' indices, XDMF)."""

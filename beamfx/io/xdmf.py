@@ -9,13 +9,25 @@ duplicated between elements), on an output mesh whose cells stay on the rank tha
 element, so nothing is gathered. The mesh is the reference centre line ``X`` (written once);
 ``u`` and the other arrays are point functions per time: warp by ``u`` for the deformed shape.
 
-A restarted run cannot drop or rewrite frames of an existing file (HDF5 refuses a dataset
-that exists), so after :meth:`XdmfSeries.resume` the file holds the frames from the restart on.
+A restart (:meth:`XdmfSeries.resume`) keeps the earlier run's frames up to the checkpoint,
+as the ``.pvd`` series does: the XML is cut back to them (rank 0) and DOLFINx's ``XDMFFile``
+appends to it (mode ``"a"``, tested on 0.5.2: the new grids join each array's temporal
+collection and refer to the mesh written first). HDF5 refuses to create a data set that
+exists, and frames written after the checkpoint (a killed run) left theirs in the ``.h5``
+under the very names the restarted frames take (``/Function/u/<time>``); then that file is
+renamed ``<stem>.part<k>.h5``, the kept grids point at it, and the new frames go into a new
+``<stem>.h5`` (the ``.xdmf`` reads both; keep them together). An earlier file that cannot
+be read is set aside as ``<stem>.before_restart.xdmf`` (and ``.h5``) and the series starts
+afresh, saying so.
 """
 
 import os
+import re
+import xml.etree.ElementTree as ET
 
 import numpy as np
+
+XINCLUDE = "http://www.w3.org/2001/XInclude"
 
 
 def _keep_local(comm, nparts, tdim, cells, ghost_mode):
@@ -62,7 +74,7 @@ class XdmfSeries:
 
     def __init__(self, path, degree, arrays, comm):
         self.path, self.degree, self.arrays, self.comm = os.fspath(path), degree, arrays, comm
-        self.file = None
+        self.file, self.mode = None, "w"
 
     def _open(self, fields):
         import dolfinx.fem
@@ -70,8 +82,9 @@ class XdmfSeries:
 
         V, self.dof = polyline_mesh(self.comm, fields["X"], self.degree)
         self.functions = {name: dolfinx.fem.Function(V, name=name) for name in self.arrays}
-        self.file = dolfinx.io.XDMFFile(self.comm, self.path, "w")
-        self.file.write_mesh(V.mesh)
+        self.file = dolfinx.io.XDMFFile(self.comm, self.path, self.mode)
+        if self.mode == "w":  # appended: the earlier run's mesh (the same) is referred to
+            self.file.write_mesh(V.mesh)
 
     def write(self, time, fields):
         """One frame of the :func:`~beamfx.io.fields.local_fields` ``fields`` at ``time``."""
@@ -81,12 +94,104 @@ class XdmfSeries:
             f.x.array.reshape(-1, 3)[self.dof] = fields[name]
             self.file.write_function(f, float(time))
 
-    def resume(self, t_max):
-        """Start the file afresh at the next frame (see the module docstring)."""
+    def resume(self, t_max, inclusive=True):
+        """Keep the earlier run's frames up to ``t_max`` (relative tolerance 1e-12; the one at
+        ``t_max`` too if ``inclusive``) and append the next ones (see the module docstring).
+        Collective; returns a note for the log, or None."""
         self.close()
+        out = _resume_file(self.path, t_max, inclusive) if self.comm.rank == 0 else None
+        self.mode, note = self.comm.bcast(out) if self.comm.size > 1 else out
+        return note
 
     def close(self):
         """Close the file (again: nothing)."""
         if self.file is not None:
             self.file.close()
             self.file = None
+
+
+def _resume_file(path, t_max, inclusive):
+    """(mode of the restart's XDMFFile, note or None) after the earlier ``path`` is cut back
+    to the frames up to ``t_max`` (rank 0: see the module docstring)."""
+    stem = path.removesuffix(".xdmf")
+    h5 = stem + ".h5"
+    if not os.path.exists(path):
+        return "w", None
+    try:
+        ET.register_namespace("xi", XINCLUDE)
+        tree = ET.parse(path)
+        frames = _frames(tree)
+        if not os.path.exists(h5):
+            raise OSError(f"{os.path.basename(h5)} is missing")
+    except (ET.ParseError, OSError, ValueError, AttributeError) as e:
+        return "w", _set_aside(path, stem, h5, e)
+    top = t_max * (1 + 1e-12) + 1e-300
+    keep = (lambda t: t <= top) if inclusive else (lambda t: t < t_max * (1 - 1e-12))
+    for parent, grid, t in frames:
+        if not keep(t):
+            parent.remove(grid)
+    note = None
+    if any(t > top for _, _, t in frames):  # their data sets hold the restart's names
+        part = _free_part(stem)
+        _point_at(tree, os.path.basename(h5), os.path.basename(part))
+        os.replace(h5, part)
+        note = (
+            f"XDMF: the frames after the checkpoint left their data in {os.path.basename(h5)}, "
+            f"where the restart's frames of those times cannot be written: it is now "
+            f"{os.path.basename(part)}, read by {os.path.basename(path)} for the frames up to "
+            f"t = {t_max:.6g} (keep it beside it)"
+        )
+    _write(tree, path)
+    return "a", note
+
+
+def _frames(tree):
+    """(collection, grid, time) of every frame of the temporal collections of ``tree``."""
+    out = []
+    for collection in tree.getroot().iter("Grid"):
+        if collection.get("GridType") != "Collection":
+            continue
+        for grid in collection.findall("Grid"):
+            out.append((collection, grid, float(grid.find("Time").get("Value"))))
+    return out
+
+
+def _free_part(stem):
+    """``<stem>.part<k>.h5`` with the first k not in use."""
+    k = 1
+    while os.path.exists(f"{stem}.part{k}.h5"):
+        k += 1
+    return f"{stem}.part{k}.h5"
+
+
+def _point_at(tree, old, new):
+    """Let every data item of the file ``old`` (``old:/path``) read the file ``new``."""
+    for item in tree.getroot().iter("DataItem"):
+        if item.text and item.text.strip().startswith(f"{old}:"):
+            item.text = new + item.text.strip()[len(old) :]
+
+
+def _write(tree, path):
+    """Write ``tree`` over ``path`` (atomically), declaring the XInclude prefix that
+    DOLFINx's appended grids use even if no kept grid uses it."""
+    text = ET.tostring(tree.getroot(), encoding="unicode")
+    if f'xmlns:xi="{XINCLUDE}"' not in text:
+        text = re.sub(r"^<Xdmf\b", f'<Xdmf xmlns:xi="{XINCLUDE}"', text, count=1)
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write('<?xml version="1.0"?>\n' + text + "\n")
+    os.replace(tmp, path)
+
+
+def _set_aside(path, stem, h5, error):
+    """Rename an earlier XDMF series that cannot be read or appended to; the note."""
+    names = []
+    for old, ext in ((path, "xdmf"), (h5, "h5")):
+        if os.path.exists(old):
+            os.replace(old, f"{stem}.before_restart.{ext}")
+            names.append(os.path.basename(f"{stem}.before_restart.{ext}"))
+    return (
+        f"XDMF: the earlier {os.path.basename(path)} cannot be continued ({error}): kept as "
+        f"{' and '.join(names)}; the XDMF series starts afresh at the restart (its frames "
+        "before it are in the .pvd series)"
+    )
