@@ -66,7 +66,7 @@ class XdmfSeries:
     """``<stem>.xdmf`` and ``<stem>.h5``: the point arrays of every frame (collective).
 
     Args:
-        path: the ``.xdmf`` file (replaced at the first frame).
+        path: the ``.xdmf`` file (replaced at the first frame; continued after :meth:`resume`).
         degree: the element degree k.
         arrays: names of the (n, 3) point arrays to write.
         comm: the communicator of the model.

@@ -98,3 +98,23 @@ def test_frames_past_the_checkpoint_of_a_killed_run_are_replaced(whole, tmp_path
     assert_same(frames(whole), frames(out))
     run_scene(tmp_path / "a.toml", out, log=lambda m: None)  # a fresh run: one .h5 again
     assert sorted(p.name for p in out.glob("deformed*.h5")) == ["deformed.h5"]
+
+
+def test_an_unreadable_earlier_xdmf_file_is_set_aside_not_lost(tmp_path):
+    """A deformed.xdmf cut short (a run killed while DOLFINx rewrote it) cannot be continued:
+    it and its .h5 are kept as deformed.before_restart.*, the series starts afresh ("w"),
+    and the note says so; without an earlier file the series simply starts ("w", no note)."""
+    from beamfx.io.xdmf import _resume_file
+
+    path = tmp_path / "deformed.xdmf"
+    assert _resume_file(str(path), 1.0, True) == ("w", None)
+    path.write_text('<?xml version="1.0"?>\n<Xdmf Version="3.0">\n  <Domain>\n    <Grid Na')
+    (tmp_path / "deformed.h5").write_bytes(b"frames")
+    mode, note = _resume_file(str(path), 1.0, True)
+    assert mode == "w" and "cannot be continued" in note
+    assert "deformed.before_restart.xdmf and deformed.before_restart.h5" in note
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "deformed.before_restart.h5",
+        "deformed.before_restart.xdmf",
+    ]
+    assert (tmp_path / "deformed.before_restart.h5").read_bytes() == b"frames"
