@@ -127,6 +127,8 @@ def _resume_file(path, t_max, inclusive):
         return "w", _set_aside(path, stem, h5, e)
     top = t_max * (1 + 1e-12) + 1e-300
     keep = (lambda t: t <= top) if inclusive else (lambda t: t < t_max * (1 - 1e-12))
+    if not any(keep(t) for _, _, t in frames):  # nothing to keep: replaced at the first frame
+        return "w", None  # (the condensed model's frames when the full one takes over)
     for parent, grid, t in frames:
         if not keep(t):
             parent.remove(grid)

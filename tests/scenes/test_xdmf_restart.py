@@ -118,3 +118,66 @@ def test_an_unreadable_earlier_xdmf_file_is_set_aside_not_lost(tmp_path):
         "deformed.before_restart.xdmf",
     ]
     assert (tmp_path / "deformed.before_restart.h5").read_bytes() == b"frames"
+
+
+XDMF = """<?xml version="1.0"?>
+<Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude">
+  <Domain>
+    <Grid Name="mesh" GridType="Uniform">
+      <Geometry GeometryType="XYZ">
+        <DataItem Dimensions="3 3" Format="HDF">deformed.h5:/Mesh/mesh/geometry</DataItem>
+      </Geometry>
+    </Grid>
+    <Grid Name="u" GridType="Collection" CollectionType="Temporal">{grids}
+    </Grid>
+  </Domain>
+</Xdmf>
+"""
+GRID = """
+      <Grid Name="u" GridType="Uniform">
+        <xi:include xpointer="xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]/*)" />
+        <Time Value="{t!r}" />
+        <Attribute Name="u" AttributeType="Vector" Center="Node">
+          <DataItem Dimensions="3 3" Format="HDF">deformed.h5:/Function/u/{t!r}</DataItem>
+        </Attribute>
+      </Grid>"""
+
+
+@pytest.mark.parametrize("t_max, inclusive, kept, part", [
+    (0.2, True, [0.0, 0.1, 0.2], True),  # frames past the checkpoint: a killed run
+    (0.3, False, [0.0, 0.1, 0.2], False),  # the frame where it stopped, off the grid: dropped
+    (0.3, True, [0.0, 0.1, 0.2, 0.3], False),
+])  # fmt: skip
+def test_the_xml_is_cut_back_to_the_checkpoint(tmp_path, t_max, inclusive, kept, part):
+    """The grids up to the checkpoint stay; with grids past it, the .h5 becomes part1 and
+    every data item (the mesh's too) reads it; the XInclude prefix stays declared."""
+    import xml.etree.ElementTree as ET
+
+    from beamfx.io.xdmf import _resume_file
+
+    path = tmp_path / "deformed.xdmf"
+    path.write_text(XDMF.format(grids="".join(GRID.format(t=t) for t in (0.0, 0.1, 0.2, 0.3))))
+    (tmp_path / "deformed.h5").write_bytes(b"frames")
+    mode, note = _resume_file(str(path), t_max, inclusive)
+    assert mode == "a" and (note is not None) == part
+    text = path.read_text()
+    assert [float(t) for t in re.findall(r'<Time Value="([^"]+)"', text)] == kept
+    root = ET.fromstring(text)  # well-formed, xi declared
+    assert root.find("Domain") is not None and 'xmlns:xi="http' in text
+    items = [d.text for d in root.iter("DataItem")]
+    h5 = "deformed.part1.h5" if part else "deformed.h5"
+    assert len(items) == 1 + len(kept) and all(d.startswith(f"{h5}:/") for d in items)
+    assert (tmp_path / h5).read_bytes() == b"frames"
+    assert (tmp_path / "deformed.h5").exists() == (not part)
+
+
+def test_nothing_to_keep_starts_the_file_afresh(tmp_path):
+    """No frame up to t_max (the condensed model's frames when the full one takes over,
+    resume(0)): mode "w", the file replaced at the first frame, no part file."""
+    from beamfx.io.xdmf import _resume_file
+
+    path = tmp_path / "deformed.xdmf"
+    path.write_text(XDMF.format(grids="".join(GRID.format(t=t) for t in (0.1, 0.2))))
+    (tmp_path / "deformed.h5").write_bytes(b"frames")
+    assert _resume_file(str(path), 0.0, True) == ("w", None)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["deformed.h5", "deformed.xdmf"]
