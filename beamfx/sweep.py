@@ -54,7 +54,8 @@ def _solve_member(member, folder, comm, log, run_scene, **options):
         row.update(status=results.result.status, **summary(results))
         if results.result.reason is not None:  # stopped before the end (sweep.md says why)
             row["reason"] = results.result.reason
-    except (SolveFailed, SceneError) as e:  # a member's values may clash (built lazily)
+    except (SolveFailed, SceneError, ValueError) as e:  # a member's values may clash (built
+        # lazily), or its model be found too small for its settings once built (modes)
         row.update(status="failed", reason=str(e))
     row["wall_s"] = time.perf_counter() - t0
     row["folder"] = folder.name

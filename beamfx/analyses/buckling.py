@@ -59,6 +59,9 @@ class BucklingResult(NamedTuple):
     # per unit load factor for about="undeformed")
     seconds: dict
     negative_eigenvalues: int | None = None  # of K* (None: non-conservative loads, not counted)
+    sought: int = 0  # eigenpairs asked of SLEPc (roots of both signs and complex ones)
+    converged: int = 0  # eigenpairs SLEPc converged (fewer than sought: all it could find)
+    other_sign: tuple = ()  # real finite roots λ* + μ of the other sign, nearest first
 
 
 def _tangent(A, J_form, bcs, diagonal):
@@ -276,9 +279,10 @@ def is_real(mu, residual):
 
 
 def _keep(mu, sign, n_modes, residuals):
-    """Indices of the real roots μ of ``sign`` (:data:`SIGNS`), nearest zero first
-    (:func:`is_real` with the roots' ``residuals``; their real parts are used)."""
-    real = [i for i in range(len(mu)) if is_real(mu[i], residuals[i])]
+    """Indices of the real finite roots μ of ``sign`` (:data:`SIGNS`), nearest zero first
+    (:func:`is_real` with the roots' ``residuals``; their real parts are used). An infinite μ
+    (a K_g without that direction: no load reaches it) is no buckling load."""
+    real = [i for i in range(len(mu)) if np.isfinite(mu[i]) and is_real(mu[i], residuals[i])]
     wanted = {"positive": lambda m: m > 0, "negative": lambda m: m < 0, "both": lambda m: True}
     return sorted((i for i in real if wanted[sign](mu[i].real)), key=lambda i: abs(mu[i]))[:n_modes]
 
@@ -292,6 +296,7 @@ def solve_buckling(
     prefix="beamfx_buckling_",
     eps=1e-4,
     sign="positive",
+    most=None,
 ):
     """The ``n_modes`` critical load factors of ``sign`` nearest the state, and their modes.
 
@@ -301,7 +306,10 @@ def solve_buckling(
     analysis; the model is left undeformed at load factor 0) or "current" (about ``model.w``
     at the current load factor, both left unchanged). ``kg``: "stress" or "path" (module doc);
     ``eps`` is the relative step of "path". The inertia of K* is counted for conservative
-    loads (``negative_eigenvalues``).
+    loads (``negative_eigenvalues``). ``most``: the most eigenpairs the problem has (its free
+    dofs, :mod:`.mode_count`), which caps the pairs asked of SLEPc. Fewer converged pairs than
+    asked are not an error: the result holds the roots found (``sought``, ``converged``),
+    possibly fewer than ``n_modes`` or none (loads that compress nothing).
 
     Raises:
         ValueError: for the linear kinematics (no geometric stiffness) or a bad option.
@@ -336,11 +344,14 @@ def solve_buckling(
     Kg.scale(-1.0)
     t4 = time.perf_counter()
     nev = 2 * n_modes + 2  # roots of both signs come out; keep those of the sign asked
-    pairs = solve_eigen(K, Kg, nev, 0.0, prefix, options, hermitian=False)
+    nev = max(1, min(nev, most)) if most is not None else nev
+    pairs = solve_eigen(K, Kg, nev, 0.0, prefix, options, hermitian=False, least=0)
     K.destroy()
     Kg.destroy()
     mu = pairs.values
     keep = _keep(mu, sign, n_modes, pairs.residuals)
+    other = {"positive": "negative", "negative": "positive"}.get(sign)
+    opposite = _keep(mu, other, n_modes, pairs.residuals) if other else []
     for i in sorted(set(range(len(mu))) - set(keep)):  # (destroy is collective: one order)
         pairs.vectors[i].destroy()
     lam = float(model.load_factor.value)
@@ -357,6 +368,9 @@ def solve_buckling(
         dw,
         seconds,
         negative,
+        nev,
+        len(mu),
+        tuple((lam + mu.real[opposite]).tolist()),
     )
 
 

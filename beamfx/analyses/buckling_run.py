@@ -1,9 +1,11 @@
 """Linear buckling of a scene (``[analysis] type = "buckling"``): load factors and modes about
 the undeformed state or about the current (loaded) one; one frame per mode."""
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from ..settings import option
+from ..spec import Model
 from .context import RunContext
 from .formulation import BeamFormulation
 from .registry import Analysis
@@ -28,6 +30,35 @@ class Settings:
         doc="load factors of the loads as given, reversed (negative factors) or both",
     )
 
+    def problems_in(self, spec: Model) -> Iterator[tuple[str, str]]:
+        """Loads to multiply (:func:`loaded`), and no more modes than free dofs."""
+        from .mode_count import modes_problem
+
+        if not loaded(spec):
+            yield "type", NO_LOADS
+        problem = modes_problem(spec, self.modes, "buckling")
+        if problem:
+            yield "modes", problem
+
+
+#: the message of a buckling scene without loads
+NO_LOADS = (
+    "a buckling analysis needs loads: its load factors multiply them, and none is given "
+    "(no [[loads]] with a nonzero force, moment or gravity, no [[supports]] with a prescribed "
+    "displacement or rotation); allowed: add the loads whose critical multiple you want"
+)
+
+
+def loaded(spec: Model) -> bool:
+    """Whether the model (a :class:`~beamfx.spec.Model`) has a load a buckling analysis can
+    multiply: a nonzero point or distributed load, gravity, or a prescribed support value."""
+    loads = (*spec.point_loads, *spec.distributed_loads)
+    return (
+        any(any(ld.force) or any(ld.moment) for ld in loads)
+        or any(spec.gravity)
+        or any(any(s.displacement) or any(s.rotation) for s in spec.supports)
+    )
+
 
 @dataclass(frozen=True, kw_only=True)
 class Result(_Base):
@@ -44,6 +75,10 @@ class Result(_Base):
     )
     mode_shapes: tuple = entry("each mode's displacement at the probes (largest nodal = 1)")
     paraview_steps: str = entry("what the ParaView frames hold")
+    note: str | None = entry(
+        "why fewer load factors than modes came out (None: all did), e.g. none: loads that "
+        "compress nothing"
+    )
 
     def summary(self) -> dict:
         """The numbers of a sweep table: the critical load factors, critical points passed."""
@@ -56,8 +91,12 @@ class Result(_Base):
 def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """The buckling eigenproblem (K + λ K_G) φ = 0 about the chosen state."""
     from .buckling import solve_buckling
+    from .mode_count import check_modes, free_dofs_of, mesh_nodes
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes
 
+    if not loaded(ctx.spec):  # a model made in code (a scene file is refused on reading)
+        raise ValueError(f"{ctx.file}: analysis.type: {NO_LOADS}")
+    check_modes(model, ctx.spec, settings.modes, "buckling", ctx.file)
     steps = ()
     if settings.about == "current":
         steps = prestress(
@@ -70,6 +109,7 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         about=settings.about,
         options=ctx.solver_options,
         sign="both" if current else settings.sign,
+        most=free_dofs_of(ctx.spec, mesh_nodes(model)),
     )
     both = tuple(res.load_factors.tolist()) if current else ()
     if current:
@@ -78,6 +118,9 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         ctx.log(f"  buckling mode {i}: load factor {lam:.8g}")
     if current:
         _report_state(ctx, res.negative_eigenvalues, both, float(model.load_factor.value))
+    note = shortfall(res, settings, both)
+    if note:
+        ctx.log(f"warning: {note}")
     return Result(
         analysis=ctx.analysis,
         load_steps=tuple(steps),
@@ -89,6 +132,39 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         load_factors_both_signs=both,
         mode_shapes=shapes(model, res.modes, ctx),
         paraview_steps=PARAVIEW_STEPS,
+        note=note,
+    )
+
+
+def shortfall(res, settings, both=()):
+    """Why fewer load factors than ``modes`` came out, in words (None if all did): none at
+    all (the loads put no member in compression, or only the reversed loads would buckle it),
+    or fewer (SLEPc converged all the finite roots there are, fewer than asked)."""
+    found, asked = len(res.load_factors), settings.modes
+    if found >= asked:
+        return None
+    sign = settings.sign
+    other = res.other_sign or tuple(x for x in both if x not in set(res.load_factors))
+    pairs = f"SLEPc converged {res.converged} eigenpairs, {res.sought} sought"
+    if found:
+        return (
+            f"found {found} of the {asked} buckling load factors asked of sign {sign!r} ({pairs}; "
+            "the others are of the other sign, complex or infinite: no load reaches them)"
+        )
+    why = "no buckling load factor found"
+    if sign != "both":
+        why += f" of sign {sign!r}"
+    hint = (
+        f"; the reversed loads buckle at load factor(s) {', '.join(f'{x:.6g}' for x in other)} "
+        "(sign = 'negative' or 'both' reports them)"
+        if other and sign == "positive"
+        else f"; load factors of the other sign: {', '.join(f'{x:.6g}' for x in other)}"
+        if other
+        else ""
+    )
+    return (
+        f"{why}: the loads put no member in compression? (a column in tension, a lateral "
+        f"force on a section that cannot tip, a load no dof feels; {pairs}){hint}"
     )
 
 

@@ -209,7 +209,15 @@ def solve_modes(
             modes = arrays_to_functions(model, pairs.vectors[:n_modes])
         else:
             pairs = solve_eigen(
-                K, M, n_modes, target, prefix, options, hermitian=is_symmetric(K), shift=shift
+                K,
+                M,
+                n_modes,
+                target,
+                prefix,
+                options,
+                hermitian=is_symmetric(K),
+                shift=shift,
+                asked=f"{n_modes} modes",
             )
             for x in pairs.vectors[n_modes:]:
                 x.destroy()

@@ -1,6 +1,7 @@
 """Modal analysis of a scene (``[analysis] type = "modal"``): natural frequencies about the
 unloaded state or, under loads, about the pre-stressed one; one frame per mode."""
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -34,6 +35,14 @@ class Settings:
         (a static solve) needs supports."""
         return not (self.prestress and _loaded(spec))
 
+    def problems_in(self, spec: "Model") -> Iterator[tuple[str, str]]:
+        """No more modes than the model's free dofs with mass (:mod:`.mode_count`)."""
+        from .mode_count import modes_problem
+
+        problem = modes_problem(spec, self.modes, "modal", rotary=self.rotary_inertia)
+        if problem:
+            yield "modes", problem
+
 
 def _loaded(spec):
     """Whether the scene's model (a :class:`~beamfx.spec.Model`) carries any load."""
@@ -60,15 +69,11 @@ class Result(_Base):
 def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Pre-stress (if loaded and asked), then the modes nearest ``target_hz``."""
     from .modal import effective_masses, solve_modes
+    from .mode_count import check_modes
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes
 
     ctx.require_mass(model, "modal")
-    if settings.modes > model.unknowns():  # bad input, said before the (pre-stress) solve
-        raise ValueError(
-            f"{ctx.file}: analysis.modes = {settings.modes}: the model has "
-            f"{model.unknowns()} unknowns, so at most that many modes (fewer: less its "
-            "supported ones)"
-        )
+    check_modes(model, ctx.spec, settings.modes, "modal", ctx.file, settings.rotary_inertia)
     spec, steps = ctx.spec, ()
     if settings.prestress and _loaded(spec):
         steps = prestress(

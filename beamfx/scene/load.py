@@ -77,7 +77,18 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     masses = read_masses(top)
     plane, condense, kin, formulation = _model_table(top.table("model", {}))
     at = top.table("analysis", {})
-    analysis, settings = _analysis(at, Model(tuple(beams), tuple(supports)), limits)
+    given = Model(  # as given, for the settings' checks against the model (modes, loads)
+        tuple(beams),
+        tuple(supports),
+        tuple(point_loads),
+        tuple(distributed),
+        tuple(springs),
+        gravity,
+        kin,
+        point_masses=tuple(masses),
+        releases=tuple(frames.releases),
+    )
+    analysis, settings = _analysis(at, given, limits)
     if frames.releases and analysis.name not in RELEASE_ANALYSES:
         top.fail(
             "frames",

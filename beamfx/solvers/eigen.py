@@ -39,39 +39,45 @@ def _reason_name(solver):
     return next((k for k, v in names.items() if v == code and not k.startswith("_")), str(code))
 
 
-def _too_few(solver, n, nev, prefix):
+def _too_few(solver, n, nev, prefix, asked=None):
     """The :class:`~beamfx.solvers.snes.SolveFailed` of a solve that converged ``n`` < ``nev``
-    pairs, with the values it got; the solver is destroyed."""
+    pairs, with the values it got; the solver is destroyed. ``asked``: what the user asked
+    for, in words (e.g. "193 modes"), when it is not the ``nev`` pairs sought."""
     from .snes import SolveFailed
 
     got = [complex(solver.getEigenvalue(i)) for i in range(n)]
     reason, its = _reason_name(solver), solver.getIterationNumber()
     solver.destroy()
     values = [v.real if v.imag == 0 else [v.real, v.imag] for v in got]
+    asked = asked or f"{nev} eigenpairs"
+    remedy = (
+        "ask for fewer modes ([analysis] modes; the model may have fewer finite eigenvalues "
+        "than asked: refine it) or give SLEPc more iterations ([solver] eps_max_it, default 200)"
+    )
     return SolveFailed(
-        f"eigen solve ({prefix}): {n} of {nev} eigenpairs converged after {its} iterations "
-        f"(SLEPc {reason}); cause: eigen solve; remedy: ask for fewer modes (the model may have fewer than asked: refine it) or give SLEPc more "
-        "iterations ([solver] eps_max_it, default 200)",
+        f"eigen solve ({prefix}): found {n} of the {asked} asked ({n} of {nev} eigenpairs "
+        f"converged after {its} iterations, SLEPc {reason}); cause: eigen solve; remedy: "
+        f"{remedy}",
         cause="eigen solve",
-        remedy="ask for fewer modes ([analysis] modes) or give SLEPc more iterations "
-        "([solver] eps_max_it, default 200)",
+        remedy=remedy,
         details={"requested": nev, "converged": n, "eigenvalues": values, "reason": reason},
     )
 
 
-def solve_and_collect(solver, A, nev, prefix, keep):
+def solve_and_collect(solver, A, nev, prefix, keep, least=None, asked=None):
     """Run a configured SLEPc EPS or PEP ``solver`` (operators of the size of ``A``), check
-    that ``nev`` pairs converged, and return (values, [keep(vr, vi) per pair], errors,
-    iterations); the solver is destroyed.
+    that ``least`` (default ``nev``) pairs converged, and return (values, [keep(vr, vi) per
+    pair], errors, iterations); the solver is destroyed. ``asked``: what the user asked for,
+    for the message (:func:`_too_few`).
 
     Raises:
-        SolveFailed: if fewer than ``nev`` pairs converged (cause "eigen solve"; ``details``
+        SolveFailed: if fewer than ``least`` pairs converged (cause "eigen solve"; ``details``
             holds the eigenvalues it found).
     """
     solver.solve()
     n = solver.getConverged()
-    if n < nev:
-        raise _too_few(solver, n, nev, prefix)
+    if n < (nev if least is None else least):
+        raise _too_few(solver, n, nev, prefix, asked)
     values, vectors, errors = [], [], []
     vr, vi = A.createVecs()
     for i in range(n):
@@ -84,7 +90,9 @@ def solve_and_collect(solver, A, nev, prefix, keep):
     return values, vectors, errors, its
 
 
-def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=None):
+def solve_eigen(
+    A, B, nev, target, prefix, options=None, hermitian=True, shift=None, least=None, asked=None
+):
     """The ``nev`` eigenpairs of A x = λ B x nearest to ``target``.
 
     Args:
@@ -96,9 +104,11 @@ def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=N
         options: PETSc options (without the prefix) that override :data:`DEFAULT_OPTIONS`.
         hermitian: GHEP (A, B symmetric, B semi-definite) or GNHEP.
         shift: shift of the spectral transform; None: ``target``.
+        least: the fewest converged pairs accepted (default ``nev``); more may be returned.
+        asked: what the caller's user asked for, in words, for the failure's message.
 
     Raises:
-        SolveFailed: if fewer than ``nev`` pairs converged.
+        SolveFailed: if fewer than ``least`` pairs converged.
     """
     from slepc4py import SLEPc
 
@@ -114,7 +124,9 @@ def solve_eigen(A, B, nev, target, prefix, options=None, hermitian=True, shift=N
     eps.getST().setShift(target if shift is None else shift)
     with petsc_options(prefix, {**DEFAULT_OPTIONS, **(options or {})}):
         eps.setFromOptions()
-    values, vectors, errors, its = solve_and_collect(eps, A, nev, prefix, lambda vr, vi: vr.copy())
+    values, vectors, errors, its = solve_and_collect(
+        eps, A, nev, prefix, lambda vr, vi: vr.copy(), least, asked
+    )
     order = np.argsort(np.abs(np.asarray(values) - target), kind="stable")
     return EigenPairs(
         np.asarray(values)[order],
