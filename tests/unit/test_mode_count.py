@@ -1,0 +1,75 @@
+"""The count of free dofs with a finite eigenvalue (beamfx.analyses.mode_count) that bounds
+``[analysis] modes`` on reading: exact for a cantilever, an upper bound elsewhere."""
+
+import tomllib
+
+import pytest
+
+from beamfx.analyses.mode_count import count_dofs, free_dofs_of, spec_nodes
+from beamfx.scene import SceneError, parse_scene
+
+BEAM = """
+[material]
+E = 210e9
+rho = 7850
+
+[[beams]]
+name = "b"
+curve = {{ shape = "line", start = [0, 0, 0], end = [1, 0, 0] }}
+section = {{ type = "circle", d = 0.02 }}
+elements = {elements}
+degree = {degree}
+
+[[supports]]
+at = "b:start"
+fix = "all"
+{more}
+[analysis]
+type = "modal"
+modes = {modes}
+{analysis}
+"""
+
+
+def spec(elements=16, degree=3, more="", analysis="", modes=1):
+    text = BEAM.format(elements=elements, degree=degree, more=more, analysis=analysis, modes=modes)
+    return parse_scene(tomllib.loads(text), "my.toml").model
+
+
+def test_a_clamped_cantilever_has_six_per_free_node():
+    """16 x P3: 49 nodes, 343 unknowns (7 per node: the quaternion's fourth has no mass); the
+    clamp takes one node: 48 x 6 = 288, the pairs SLEPc converged when asked for 340."""
+    model = spec()
+    assert spec_nodes(model) == 49
+    assert free_dofs_of(model, rotary="full") == 288
+    assert free_dofs_of(model) == 288  # buckling: every nodal dof
+    assert count_dofs(model, rotary="none") == (49, 3, 0, 3)
+    assert free_dofs_of(model, rotary="polar") == 48 * 4  # the clamp fixes the polar one too
+
+
+def test_point_masses_releases_and_local_supports():
+    """A point mass with rotary inertia gives its node its rotations back ("none"); a support
+    in local axes is a spring (its dofs stay unknowns); a second support at the same point
+    fixes nothing twice."""
+    mass = '\n[[masses]]\nat = "b:end"\nmass = 1.0\ninertia = [1e-3, 1e-3, 1e-3]\n'
+    assert free_dofs_of(spec(more=mass), rotary="none") == 48 * 3 + 3
+    local = '\n[[supports]]\nat = "b:end"\nfix = ["uy"]\naxes = "local"\n'
+    assert free_dofs_of(spec(more=local), rotary="full") == 288
+    twice = '\n[[supports]]\nat = "b:start"\nfix = ["ux", "uy"]\n'
+    assert free_dofs_of(spec(more=twice), rotary="full") == 288
+
+
+def test_the_planar_model_has_three_per_node():
+    """[model] plane = "xy": ux, uy, rz per node; "polar" leaves rz (a bending axis) no mass."""
+    model = spec(more='\n[model]\nplane = "xy"\n')
+    assert free_dofs_of(model, rotary="full") == 48 * 3
+    assert free_dofs_of(model, rotary="polar") == 48 * 2
+
+
+def test_modes_beyond_the_count_are_refused_with_the_count():
+    with pytest.raises(SceneError) as e:
+        spec(elements=2, degree=2, analysis='rotary_inertia = "none"', modes=13)
+    message = str(e.value)
+    assert message.startswith("my.toml: analysis.modes = 13: more than a modal analysis")
+    assert "5 nodes x 3 dofs with mass (rotary_inertia = 'none') − 3 fixed" in message
+    assert "allowed: an integer in [1, 12]" in message
