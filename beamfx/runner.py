@@ -338,7 +338,7 @@ def _finish(run, out, scene, refinement, log, comm, png, animate):
         pictures = write_pictures(out, run.to_json(), log, animate, comm=comm)
         run = replace(run, pictures=pictures)
     write_json_atomic(out / "results.json", run.to_json(), comm)
-    log(f"done in {run.wall_time_s['run']:.2f} s; results in {out / 'results.json'}")
+    log(_ending(run, out))
     if refinement:
         estimate = f"{refinement.estimate:.3g}" if refinement.estimate is not None else "none"
         log(
@@ -352,6 +352,17 @@ def _finish(run, out, scene, refinement, log, comm, png, animate):
             f"displacement {[round(x, 6) for x in v['displacement']]}"
         )
     return run
+
+
+def _ending(run, out):
+    """The last line of a run's log: "done in" for a converged run, else its status first
+    ("failed after", "stopped after": a "done" before the failure read as a success; the
+    reason is in results.json and ``beamfx run`` prints it)."""
+    where = f"results in {out / 'results.json'}"
+    seconds = run.wall_time_s["run"]
+    if run.converged:
+        return f"done in {seconds:.2f} s; {where}"
+    return f"{run.result.status} after {seconds:.2f} s; {where}"
 
 
 def check_scene(path: str | os.PathLike) -> "Scene | Sweep":

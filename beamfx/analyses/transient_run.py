@@ -10,6 +10,7 @@ steps a checkpoint lets ``beamfx run --restart`` go on from there.
 """
 
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -29,6 +30,8 @@ if TYPE_CHECKING:  # heavy (UFL, PETSc): imported where used
 
 _now = time.perf_counter
 SCHEMES = ("generalized_alpha", "hht", "newmark", "conserving", "extrapolated")
+#: the schemes that use each scheme parameter (the others would ignore it: refused)
+SCHEME_PARAMETERS = {"rho_inf": ("generalized_alpha", "extrapolated"), "hht_alpha": ("hht",)}
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,22 @@ class Settings:
                     "share their steps): remove tolerance, or choose another scheme"
                 ),
             )
+
+    def problems_given(self, given: set) -> Iterator[tuple[str, str]]:
+        """(key, message) of a parameter given for a scheme other than the chosen one (it
+        would be ignored: ``rho_inf`` with ``scheme = "hht"``)."""
+        for key, schemes in SCHEME_PARAMETERS.items():
+            if key in given and self.scheme not in schemes:
+                own = [k for k, s in SCHEME_PARAMETERS.items() if self.scheme in s]
+                takes = f"it takes {own[0]!r}" if own else "it has no parameter"
+                named = " or ".join(map(repr, schemes))
+                yield (
+                    key,
+                    (
+                        f"is a parameter of scheme = {named}, not of scheme = {self.scheme!r} "
+                        f"({takes}); remove it or choose that scheme"
+                    ),
+                )
 
     def free_body(self, spec: "Model") -> bool:
         """A free structure may fly from rest (the mass makes the step's operator regular);

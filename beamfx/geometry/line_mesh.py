@@ -88,7 +88,8 @@ def _read_msh(path):
             if kind in LINE_TYPES:
                 key = tuple(int(v) for v in cell)
                 if key[::-1] in members:  # the same member twice would overlap itself
-                    raise ValueError(f"{path}: nodes {list(key)} are joined by two members")
+                    nodes = [n + 1 for n in key]  # numbered from 1, as in the file
+                    raise ValueError(f"{path}: nodes {nodes} are joined by two members")
                 index = members.setdefault(key, len(members))
                 name = names.get((1, tag))
                 if name is not None:
@@ -101,7 +102,8 @@ def _read_msh(path):
     lengths = np.linalg.norm(points[lines[:, 1]] - points[lines[:, 0]], axis=1)
     if np.any(lengths <= 1e-12 * max(np.ptp(points), 1e-300)):
         i = int(np.argmin(lengths))
-        raise ValueError(f"{path}: member {i + 1} (nodes {lines[i].tolist()}) has zero length")
+        nodes = (lines[i] + 1).tolist()  # numbered from 1, as the file and _describe do
+        raise ValueError(f"{path}: member {i + 1} (nodes {nodes}) has zero length")
     return LineMesh(
         points,
         lines,

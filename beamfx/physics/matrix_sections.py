@@ -96,9 +96,11 @@ def check_mass(M):
     scale = max(np.abs(M).max(), 1e-300)
     m = M[0, 0]
     if np.abs(M[:3, :3] - m * np.eye(3)).max() > 1e-9 * scale:
-        raise ValueError("its translational block (rows and columns 1-3) must be m·I")
+        raise ValueError("has a translational block (rows and columns 1-3) that is not m·I")
     if np.abs(M[:3, 3:] + M[:3, 3:].T).max() > 1e-9 * scale:
-        raise ValueError("its translation-rotation block (rows 1-3, columns 4-6) must be skew")
+        raise ValueError(
+            "has a translation-rotation block (rows 1-3, columns 4-6) that is not skew"
+        )
     smallest = np.linalg.eigvalsh(M).min()
     if smallest < -1e-10 * scale:
         raise ValueError(f"is not positive semi-definite (smallest eigenvalue {smallest:.6g})")

@@ -175,9 +175,23 @@ def polygon_properties(points, holes, nu, mesh_size):
     from shapely.geometry import Polygon
     from shapely.geometry.polygon import orient
 
+    if _on_one_line(points):  # shapely calls it a "Self-intersection"
+        raise ValueError(
+            "zero area: the points lie on one line; allowed: at least 3 points not on one "
+            "line, in order around the section"
+        )
     polygon = Polygon(points, holes)
     _check_geometry(polygon)
     return _analyse(Geometry(orient(polygon), material=_material(nu)), mesh_size)
+
+
+def _on_one_line(points):
+    """Whether the points (y, z) span no area: all on one line (or one point)."""
+    xy = np.asarray(points, float)
+    if len(xy) < 3:
+        return True
+    sv = np.linalg.svd(xy - xy.mean(axis=0), compute_uv=False)
+    return not sv[1] > 1e-12 * max(sv[0], 1e-300)
 
 
 def _check_geometry(geom):

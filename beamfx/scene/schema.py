@@ -112,7 +112,11 @@ def read_settings(
         _check_range(spec, value, fail, max_count)
         values[spec.name] = value
     obj = cls(**values)
-    for key, message in getattr(obj, "problems", lambda: ())():
+    given = {s.name for s in specs(cls) if table is not None and table.has(s.name)}
+    for key, message in (
+        *getattr(obj, "problems", lambda: ())(),
+        *getattr(obj, "problems_given", lambda given: ())(given),
+    ):
         where = table.where(key) if table is not None else key
         raise SceneError(f"{where}: {message}")
     if done and table is not None:

@@ -99,7 +99,8 @@ def read_section(t, mat, length, base=Path(".")):
             ):
                 t.fail(
                     "torsion",
-                    f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a number J",
+                    f"{torsion!r} is not allowed; allowed: 'saint-venant', 'thin-strip' or a "
+                    "number J > 0 (the torsion constant, m^4)",
                 )
             params = {"h": value("h"), "w": value("w")}
             make = partial(sections.rectangle, E, G, rho, torsion=torsion, shear_factor=k, nu=nu)

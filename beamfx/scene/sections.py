@@ -226,7 +226,58 @@ def _shape_params(t, name):
             if kind == "radius" and value < 0:
                 t.fail(key, f"= {value:g}: must be >= 0 (a radius)")
         params[key] = value
+    for key, rule, holds in _SHAPE_RULES.get(name, ()):
+        if not holds(dict(params, **{k: 0.0 for k in ("r", "r_r") if k not in params})):
+            given = ", ".join(f"{k} = {params[k]:g}" for k in _names_in(rule, params))
+            t.fail(key, f"= {params[key]:g}: the {name} needs {rule} (given {given})")
     return tuple(sorted(params.items()))
+
+
+def _names_in(rule, params):
+    """The parameters named in ``rule`` (words of it that are keys of ``params``)."""
+    words = rule.replace("(", " ").replace(")", " ").replace("·", " ").split()
+    return [w for w in dict.fromkeys(words) if w in params]
+
+
+#: the walls of a built-in shape must fit in its outline (sectionproperties builds a section
+#: with a web wider than its flanges without complaint): (key blamed, rule, test) per shape
+_I_RULES = (
+    ("t_w", "t_w + 2·r < b", lambda p: p["t_w"] + 2 * p["r"] < p["b"]),
+    ("t_f", "2·t_f + 2·r < d", lambda p: 2 * p["t_f"] + 2 * p["r"] < p["d"]),
+)
+_SHAPE_RULES = {
+    "i_section": _I_RULES,
+    "tapered_flange_i_section": (
+        ("t_w", "t_w + 2·r_r < b", lambda p: p["t_w"] + 2 * p["r_r"] < p["b"]),
+        ("t_f", "2·t_f < d", lambda p: 2 * p["t_f"] < p["d"]),
+    ),
+    "mono_i_section": (
+        ("t_w", "t_w + 2·r < b_t", lambda p: p["t_w"] + 2 * p["r"] < p["b_t"]),
+        ("t_w", "t_w + 2·r < b_b", lambda p: p["t_w"] + 2 * p["r"] < p["b_b"]),
+        ("t_ft", "t_ft + t_fb + 2·r < d", lambda p: p["t_ft"] + p["t_fb"] + 2 * p["r"] < p["d"]),
+    ),
+    "channel_section": (
+        ("t_w", "t_w + r < b", lambda p: p["t_w"] + p["r"] < p["b"]),
+        ("t_f", "2·t_f + 2·r < d", lambda p: 2 * p["t_f"] + 2 * p["r"] < p["d"]),
+    ),
+    "tee_section": (
+        ("t_w", "t_w + 2·r < b", lambda p: p["t_w"] + 2 * p["r"] < p["b"]),
+        ("t_f", "t_f + r < d", lambda p: p["t_f"] + p["r"] < p["d"]),
+    ),
+    "angle_section": (
+        ("t", "t < b", lambda p: p["t"] < p["b"]),
+        ("t", "t < d", lambda p: p["t"] < p["d"]),
+    ),
+    "rectangular_hollow_section": (
+        ("t", "2·t < b", lambda p: 2 * p["t"] < p["b"]),
+        ("t", "2·t < d", lambda p: 2 * p["t"] < p["d"]),
+    ),
+    "circular_hollow_section": (("t", "2·t < d", lambda p: 2 * p["t"] < p["d"]),),
+    "elliptical_hollow_section": (
+        ("t", "2·t < d_x", lambda p: 2 * p["t"] < p["d_x"]),
+        ("t", "2·t < d_y", lambda p: 2 * p["t"] < p["d_y"]),
+    ),
+}
 
 
 def _shape_material(t, mat):

@@ -148,7 +148,11 @@ def test_limits_and_repeated_members(tripod, tmp_path):
     assert "frames[0].mesh: 3 members; allowed: at most 2" in _error(tripod(text))
     write_line_mesh(tmp_path / "tripod.msh", POINTS, [*MEMBERS, [3, 0]], {"legs": [0, 1, 2, 3]}, {})
     message = _error(tmp_path / "scene.toml")
-    assert "tripod.msh: nodes [3, 0] are joined by two members" in message
+    assert "tripod.msh: nodes [4, 1] are joined by two members" in message  # from 1
+    # a zero-length member: its nodes numbered from 1, as the nearly coincident ones are
+    points = [*POINTS, POINTS[3]]
+    write_line_mesh(tmp_path / "tripod.msh", points, [*MEMBERS, [3, 4]], {"legs": [0, 1, 2, 3]}, {})
+    assert "tripod.msh: member 4 (nodes [4, 5]) has zero length" in _error(tmp_path / "scene.toml")
 
 
 def test_closest_point_of_a_line_is_the_clipped_projection():

@@ -89,12 +89,17 @@ def test_a_hole_takes_its_area_away():
         ({"shape": "i_section", "d": 0.2, "b": 0.1, "t_f": 0.01, "t_w": 0.0, "r": 0.0}, "t_w", "> 0"),
         ({"shape": "i_section", "d": 0.2, "b": 0.1, "t_f": 0.01, "r": 0.0}, "t_w", "missing"),
         ({"shape": "channel_section", "d": 0.2, "b": 0.1, "t_f": 0.01, "t_w": 0.006, "r": -1.0}, "r", "must be >= 0"),
-        ({"shape": "i_section", "d": 0.2, "b": 0.1, "t_f": 0.15, "t_w": 0.006, "r": 0.0}, "shape", "not a valid polygon|cannot build"),
+        ({"shape": "i_section", "d": 0.2, "b": 0.1, "t_f": 0.15, "t_w": 0.006, "r": 0.0}, "t_f", r"needs 2·t_f \+ 2·r < d \(given t_f = 0.15, r = 0, d = 0.2\)"),
+        # a web wider than the flanges was built without complaint
+        ({"shape": "i_section", "d": 0.2, "b": 0.1, "t_f": 0.01, "t_w": 0.12, "r": 0.0}, "t_w", r"= 0.12: the i_section needs t_w \+ 2·r < b"),
+        ({"shape": "rectangular_hollow_section", "d": 0.2, "b": 0.1, "t": 0.06, "r_out": 0.0}, "t", r"needs 2·t < b"),
         ({"shape": "rectangular_section", "b": 1, "d": 1, "color": 1}, "color", "unknown key"),
         # sectionproperties 2.0.3's warping system is singular on this hexagon's mesh
         ({"shape": "circular_section", "d": 0.1, "n": 6, "mesh_size": 2e-5}, "shape", "analysis failed"),
         ({"type": "polygon", "points": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "points", "not a valid polygon: Self-intersection"),
         ({"type": "polygon", "points": [[0, 0], [1, 1]]}, "points", "at least 3 points"),
+        # points on one line: shapely says "Self-intersection"
+        ({"type": "polygon", "points": [[0, 0], [1, 1], [2, 2]]}, "points", "zero area: the points lie on one line"),
         ({"type": "polygon", "points": SQUARE, "holes": [[[0, 0]]]}, "holes", "hole 1: expected"),
         ({"type": "polygon", "points": SQUARE, "reference": "middle"}, "reference", "not allowed"),
         ({"type": "polygon", "points": SQUARE, "reference": [1, 2, 3]}, "reference", r"expected \[y, z\]"),
