@@ -3,6 +3,7 @@ unloaded state or, under loads, about the pre-stressed one; one frame per mode."
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,7 +26,9 @@ class Settings:
     """``[analysis]`` of a modal analysis."""
 
     modes: int = option(6, positive=True, doc="number of modes")
-    target_hz: float = option(0.0, low=0.0, doc="the modes nearest this frequency (Hz)")
+    target_hz: float = option(
+        0.0, low=0.0, doc="the modes nearest this frequency (Hz), nearest first"
+    )
     rotary_inertia: str = option("full", choices=ROTARY, doc="rotary inertia of the sections")
     prestress: bool = option(True, doc="about the static state under the scene's loads")
     steps: int = option(10, positive=True, doc="load steps of the pre-stressing solve")
@@ -69,7 +72,8 @@ class Result(_Base):
 def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
     """Pre-stress (if loaded and asked), then the modes nearest ``target_hz``."""
     from .modal import effective_masses, solve_modes
-    from .mode_count import check_modes
+    from .modal_target import solve_nearest_hz
+    from .mode_count import check_modes, free_dofs_of, mesh_nodes
     from .mode_shapes import PARAVIEW_STEPS, prestress, shapes
 
     ctx.require_mass(model, "modal")
@@ -81,9 +85,18 @@ def run(model: BeamFormulation, settings: Settings, ctx: RunContext) -> Result:
         )
         steps = steps.steps
     target = (2 * np.pi * settings.target_hz) ** 2
-    res = solve_modes(
-        model, settings.modes, target, rotary=settings.rotary_inertia, options=ctx.solver_options
+    solve = partial(
+        solve_modes,
+        model,
+        target=target,
+        rotary=settings.rotary_inertia,
+        options=ctx.solver_options,
     )
+    if settings.target_hz > 0:  # nearest in Hz, not in ω² (modal_target.py)
+        most = free_dofs_of(spec, mesh_nodes(model), settings.rotary_inertia)
+        res = solve_nearest_hz(solve, settings.modes, settings.target_hz, most)
+    else:
+        res = solve(settings.modes)
     rigid = _rigid_modes(spec, settings, res.omega)
     for i, (f, w) in enumerate(zip(res.hz, res.omega), start=1):
         kind = " rigid-body (0 Hz to round-off)" if i <= rigid else ""

@@ -39,6 +39,7 @@ def column(force=None, modes=4, elements=8):
 def _write(tmp_path, text):
     folder = Path(MPI.COMM_WORLD.bcast(str(tmp_path)))
     if MPI.COMM_WORLD.rank == 0:
+        folder.mkdir(parents=True, exist_ok=True)
         (folder / "scene.toml").write_text(text)
     MPI.COMM_WORLD.barrier()
     return folder
@@ -143,3 +144,38 @@ def test_a_sweep_member_with_too_many_modes_is_named_before_any_solve(tmp_path, 
             assert "(sweep member 1: beams.b.elements = 1, beams.b.degree = 1)" in err
             assert "analysis.modes = 30" in err and "[1, 6]" in err
     assert not (Path(MPI.COMM_WORLD.bcast(str(tmp_path))) / "out").exists()
+
+
+CANTILEVER = """
+[material]
+E = 210e9
+rho = 7850
+
+[[beams]]
+name = "b"
+curve = { shape = "line", start = [0, 0, 0], end = [2, 0, 0] }
+section = { type = "rectangle", w = 0.05, h = 0.1 }
+elements = 8
+degree = 3
+
+[[supports]]
+at = "b:start"
+fix = "all"
+
+[analysis]
+type = "modal"
+"""
+
+
+def test_target_hz_gives_the_modes_nearest_in_hz(tmp_path, capsys):
+    """At 100 Hz the four nearest in ω² are 65.2, 129.2, 20.9 and 10.4 Hz; in Hz 181.8 Hz
+    (82 Hz off) is nearer than 10.4 Hz (90 Hz off) and takes its place. Checked against the
+    40 lowest modes of the same model, nearest in Hz first."""
+    code, lowest, _, _ = run(tmp_path / "all", CANTILEVER + "modes = 40\n", capsys)
+    assert code == 0
+    f = np.array(lowest["frequencies_hz"])
+    expected = f[np.argsort(np.abs(f - 100.0), kind="stable")[:4]]
+    assert f.max() > 200 and 181 < expected[-1] < 182  # the case in point
+    code, near, _, _ = run(tmp_path / "near", CANTILEVER + "modes = 4\ntarget_hz = 100\n", capsys)
+    assert code == 0
+    assert np.allclose(near["frequencies_hz"], expected, rtol=1e-8, atol=0)

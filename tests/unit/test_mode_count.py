@@ -3,6 +3,7 @@
 
 import tomllib
 
+import numpy as np
 import pytest
 
 from beamfx.analyses.mode_count import count_dofs, free_dofs_of, spec_nodes
@@ -73,3 +74,21 @@ def test_modes_beyond_the_count_are_refused_with_the_count():
     assert message.startswith("my.toml: analysis.modes = 13: more than a modal analysis")
     assert "5 nodes x 3 dofs with mass (rotary_inertia = 'none') − 3 fixed" in message
     assert "allowed: an integer in [1, 12]" in message
+
+
+def test_the_nearest_in_hz_are_proven_only_when_the_pairs_reach_far_enough():
+    """Pairs nearest 100 Hz in ω²: 65, 129, 21, 10 Hz. The 3 nearest in Hz among them (129,
+    65, 21: 79 Hz off) are not proven: a mode up to 179 Hz (79² + 2·100·79 in Hz²) would be
+    nearer than 21 Hz and may be missing, and the pairs found reach only 9900 Hz² from the
+    target. With 182 Hz found as well they are."""
+    from beamfx.analyses.modal_target import nearest_in_hz
+
+    def lam(f):
+        return (2 * np.pi * np.asarray(f, float)) ** 2
+
+    hz = [65.0, 129.0, 21.0, 10.0]
+    keep, proven = nearest_in_hz(hz, lam(hz), 3, 100.0)
+    assert [hz[i] for i in keep] == [129.0, 65.0, 21.0] and not proven
+    hz = [65.0, 129.0, 21.0, 10.0, 182.0]
+    keep, proven = nearest_in_hz(hz, lam(hz), 3, 100.0)
+    assert [hz[i] for i in keep] == [129.0, 65.0, 21.0] and proven
