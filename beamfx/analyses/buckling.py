@@ -348,6 +348,18 @@ def solve_buckling(
     pairs = solve_eigen(K, Kg, nev, 0.0, prefix, options, hermitian=False, least=0)
     K.destroy()
     Kg.destroy()
+    seconds = {
+        "compile": (t1 - t0) + (t3 - t2),
+        "assemble": (t2 - t1) + (t4 - t3),
+        "solve": pairs.seconds,
+    }
+    return _result(model, pairs, sign, n_modes, (dw, seconds, negative, nev))
+
+
+def _result(model, pairs, sign, n_modes, rest):
+    """The :class:`BucklingResult` of the roots μ ``pairs`` (the vectors not kept destroyed);
+    ``rest``: the path tangent, the seconds, the negative eigenvalues and the pairs sought."""
+    dw, seconds, negative, nev = rest
     mu = pairs.values
     keep = _keep(mu, sign, n_modes, pairs.residuals)
     other = {"positive": "negative", "negative": "positive"}.get(sign)
@@ -355,11 +367,6 @@ def solve_buckling(
     for i in sorted(set(range(len(mu))) - set(keep)):  # (destroy is collective: one order)
         pairs.vectors[i].destroy()
     lam = float(model.load_factor.value)
-    seconds = {
-        "compile": (t1 - t0) + (t3 - t2),
-        "assemble": (t2 - t1) + (t4 - t3),
-        "solve": pairs.seconds,
-    }
     return BucklingResult(
         lam + mu.real[keep],
         mu.real[keep],

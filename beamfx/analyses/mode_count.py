@@ -40,7 +40,10 @@ def _fixed(spec):
     for s in spec.supports:
         if s.axes != "global":
             continue
-        x = resolve_point(spec, s.at, index)[2]
+        try:
+            x = resolve_point(spec, s.at, index)[2]
+        except ValueError:  # a bad point: the scene reader names it (its own check)
+            continue
         out.setdefault(tuple(round(float(c), 9) for c in x), set()).update(s.fix)
     return out
 

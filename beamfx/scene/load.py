@@ -5,7 +5,7 @@ The keys are the words of the reference files (``E``, ``nu``, ``rho``, ``EA``, `
 """
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from pathlib import Path
 
@@ -77,7 +77,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     masses = read_masses(top)
     plane, condense, kin, formulation = _model_table(top.table("model", {}))
     at = top.table("analysis", {})
-    given = Model(  # as given, for the settings' checks against the model (modes, loads)
+    model = Model(  # the settings are checked against it too (modes, loads)
         tuple(beams),
         tuple(supports),
         tuple(point_loads),
@@ -88,7 +88,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         point_masses=tuple(masses),
         releases=tuple(frames.releases),
     )
-    analysis, settings = _analysis(at, given, limits)
+    analysis, settings = _analysis(at, model, limits)
     if frames.releases and analysis.name not in RELEASE_ANALYSES:
         top.fail(
             "frames",
@@ -97,6 +97,7 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         )
     if analysis.linear:
         kin = Kinematics(False, kin.shear, kin.stretch, kin.plane)
+        model = replace(model, kinematics=kin)
 
     probes = _probes(top)
     for name in set(probes) & set(frames.probes):
@@ -108,18 +109,6 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
         top.fail(f"solver.{key}", message)
     accuracy_table = top.table("accuracy", None)
     top.done()
-
-    model = Model(
-        tuple(beams),
-        tuple(supports),
-        tuple(point_loads),
-        tuple(distributed),
-        tuple(springs),
-        gravity,
-        kin,
-        point_masses=tuple(masses),
-        releases=tuple(frames.releases),
-    )
     _check_points(model, probes, file, data.get("loads", []))
     _check_histories(model, settings, file, data.get("loads", []))
     if not model.supports and not takes_free_body(settings, model):
