@@ -111,6 +111,7 @@ def run_scene(
         if isinstance(scene, Sweep):
             from .sweep import run_sweep
 
+            check_members(scene)  # every member's input before any solve
             return run_sweep(scene, out_dir, run_scene, log=log, png=png, comm=comm)
     out = _prepare(Path(out_dir or scene.output_dir), scene, comm, out_dir is None)
     log(f"beamfx: {path} -> {out}/")
@@ -366,18 +367,34 @@ def _ending(run, out):
 
 
 def check_scene(path: str | os.PathLike) -> "Scene | Sweep":
-    """Validate a scene without solving: keys, types, points, supports; for a sweep file the
-    members validated on reading (:mod:`beamfx.scene.sweep`). Returns the scene, or the
-    :class:`~beamfx.scene.Sweep`."""
-    from .analyses.checks import check_supports_for
+    """Validate a scene without solving: keys, types, points, supports; for a sweep file every
+    member (:func:`check_members`). Returns the scene, or the :class:`~beamfx.scene.Sweep`."""
     from .io.folder import check_output_dir
-    from .scene import SceneError, Sweep, load_scene_or_sweep
+    from .scene import Sweep, load_scene_or_sweep
 
     loaded = load_scene_or_sweep(path)
-    for scene in loaded.validated if isinstance(loaded, Sweep) else [loaded]:
-        try:
-            check_supports_for(scene.model, scene.settings)
-        except ValueError as e:
-            raise SceneError(f"{scene.file}: supports: {e}") from None
+    if isinstance(loaded, Sweep):
+        check_members(loaded)
+    else:
+        _check_supports(loaded)
     check_output_dir(loaded.output_dir, str(path))
     return loaded
+
+
+def check_members(sweep: "Sweep") -> None:
+    """Build and check every member of ``sweep`` (keys, values, supports; a large sweep's
+    reading validated only some), so that bad input in any member is refused, naming the
+    member, before any is solved. About 2 ms per member of one small beam."""
+    for member in sweep.members:
+        _check_supports(member.scene)
+
+
+def _check_supports(scene):
+    """:func:`~beamfx.analyses.checks.check_supports_for` as a SceneError naming the file."""
+    from .analyses.checks import check_supports_for
+    from .scene import SceneError
+
+    try:
+        check_supports_for(scene.model, scene.settings)
+    except ValueError as e:
+        raise SceneError(f"{scene.file}: supports: {e}") from None

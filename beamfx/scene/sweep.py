@@ -20,7 +20,9 @@ members is read in a fraction of a second. When the file is read, the members ar
 (:data:`CHECK_ALL` members or fewer), otherwise every value of every table once, with the other
 tables at their first values; so a bad value is reported before anything is solved. A bad
 combination of good values (elements of one table and degree of another beyond
-``max_unknowns``) in a large sweep is then reported as that member's failure when it runs.
+``max_unknowns``, or modes of one beyond the dofs of another's mesh) in a large sweep is
+found by ``beamfx check`` and ``beamfx run``, which build every member before any solve
+(:func:`beamfx.runner.check_members`, about 2 ms a member), and refused naming the member.
 """
 
 import copy

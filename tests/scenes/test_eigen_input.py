@@ -179,3 +179,25 @@ def test_target_hz_gives_the_modes_nearest_in_hz(tmp_path, capsys):
     code, near, _, _ = run(tmp_path / "near", CANTILEVER + "modes = 4\ntarget_hz = 100\n", capsys)
     assert code == 0
     assert np.allclose(near["frequencies_hz"], expected, rtol=1e-8, atol=0)
+
+
+def test_every_member_of_a_large_sweep_is_checked_before_any_solve(tmp_path, capsys):
+    """72 members (beyond the 64 validated in full on reading, which then checks each value
+    once): elements = 1 with modes = 30 (member 9) is a combination the reading does not
+    build; `check` and `run` build every member and refuse it, naming it."""
+    from beamfx.scene import load_scene_or_sweep
+
+    text = SWEEP.replace("degree = 2", "degree = 1").replace("modes = 30", "modes = 4")
+    text = text[: text.index("[[sweep]]")] + (
+        '[[sweep]]\nkey = "beams.b.elements"\nvalues = [8, 1, 2, 3, 4, 5, 6, 7, 9]\n\n'
+        '[[sweep]]\nkey = "analysis.modes"\nvalues = [4, 30, 5, 6, 7, 8, 9, 10]\n'
+    )
+    folder = _write(tmp_path, text)
+    sweep = load_scene_or_sweep(folder / "scene.toml")  # reading alone passes
+    assert len(sweep.members) == 72 and "scene" not in sweep.members[9].__dict__
+    for command in ("check", "run"):
+        code, _, _, err = run(tmp_path, text, capsys, command)
+        assert code == 2
+        if MPI.COMM_WORLD.rank == 0:
+            assert "(sweep member 9: beams.b.elements = 1, analysis.modes = 30)" in err
+    assert not (folder / "out").exists()
