@@ -31,12 +31,15 @@ class Settings:
     )
 
     def problems_in(self, spec: Model) -> Iterator[tuple[str, str]]:
-        """Loads to multiply (:func:`loaded`), and no more modes than free dofs."""
-        from .mode_count import modes_problem
-
+        """Loads to multiply (:func:`loaded`)."""
         if not loaded(spec):
             yield "type", NO_LOADS
-        problem = modes_problem(spec, self.modes, "buckling")
+
+    def problems_on_mesh(self, spec: Model, points: tuple) -> Iterator[tuple[str, str]]:
+        """No more modes than the free dofs of the mesh of ``spec`` (:mod:`.mode_count`)."""
+        from .mode_count import modes_problem, spec_nodes
+
+        problem = modes_problem(spec, self.modes, "buckling", spec_nodes(spec, points))
         if problem:
             yield "modes", problem
 

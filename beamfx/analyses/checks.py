@@ -5,6 +5,7 @@ import numpy as np
 from ..geometry.curves import Line
 from ..geometry.frames import section_axes_at
 from ..spec import DOF_NAMES, resolve_point
+from ..spec.model import beam_index
 from .dofs import OUT_OF_PLANE
 
 
@@ -118,6 +119,27 @@ def joint_breaks(model, rtol=1e-8):
         for _, j, s in end_contacts(model, rtol)
         if tol < s < model.beams[j].curve.length - tol
     ]
+
+
+def named_breaks(spec, extra_points=()):
+    """Named points (every 'at' of supports, loads, springs, masses and ``extra_points``) as
+    {at: (beam, s, xyz)}, and the arc lengths {beam index: [s]} where the mesh needs a vertex:
+    those points, T-joints and the stations of matrix sections that ask for them.
+
+    Raises:
+        ValueError: if a point names no point of a beam.
+    """
+    ats = [x.at for x in (*spec.supports, *spec.point_loads, *spec.springs, *spec.point_masses)]
+    index = beam_index(spec)
+    named = {at: resolve_point(spec, at, index) for at in dict.fromkeys(ats + list(extra_points))}
+    breaks = {i: [] for i in range(len(spec.beams))}
+    for b, s, _ in named.values():
+        breaks[b].append(s)
+    for b, s in joint_breaks(spec):
+        breaks[b].append(s)
+    for i, b in enumerate(spec.beams):  # matrix sections that ask for vertices at stations
+        breaks[i].extend(getattr(b.section, "station_breaks", list)())
+    return named, breaks
 
 
 def connected_beams(model, rtol=1e-8):

@@ -28,9 +28,7 @@ from ..geometry.frames import default_reference
 from ..physics import coupled, energy
 from ..physics.coupled import as_matrix6
 from ..physics.kinematics import section_frame, tangent
-from ..spec import resolve_point
-from ..spec.model import beam_index
-from .checks import joint_breaks
+from .checks import named_breaks
 from .section_fields import SectionMatrices, dg_points, is_coupled, matrix_fields
 
 #: mesh -> {(degree, size): weak reference to the DG space on it} (weak both ways: a space
@@ -188,16 +186,7 @@ def _cell_tangents(mesh):
 def _beam_mesh(spec, comm, degree, extra_points):
     """Named points (every 'at' of supports, loads, springs, masses and ``extra_points``) as
     {at: (beam, s, xyz)} and the mesh with a vertex at each of them and at T-joints."""
-    ats = [x.at for x in (*spec.supports, *spec.point_loads, *spec.springs, *spec.point_masses)]
-    index = beam_index(spec)
-    named = {at: resolve_point(spec, at, index) for at in dict.fromkeys(ats + list(extra_points))}
-    breaks = {i: [] for i in range(len(spec.beams))}
-    for b, s, _ in named.values():
-        breaks[b].append(s)
-    for b, s in joint_breaks(spec):
-        breaks[b].append(s)
-    for i, b in enumerate(spec.beams):  # matrix sections that ask for vertices at stations
-        breaks[i].extend(getattr(b.section, "station_breaks", list)())
+    named, breaks = named_breaks(spec, extra_points)
     specs = [
         BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i])) for i, b in enumerate(spec.beams)
     ]

@@ -38,11 +38,13 @@ class Settings:
         (a static solve) needs supports."""
         return not (self.prestress and _loaded(spec))
 
-    def problems_in(self, spec: "Model") -> Iterator[tuple[str, str]]:
-        """No more modes than the model's free dofs with mass (:mod:`.mode_count`)."""
-        from .mode_count import modes_problem
+    def problems_on_mesh(self, spec: "Model", points: tuple) -> Iterator[tuple[str, str]]:
+        """No more modes than the free dofs with mass of the mesh of ``spec`` with vertices
+        at ``points`` too (:mod:`.mode_count`)."""
+        from .mode_count import modes_problem, spec_nodes
 
-        problem = modes_problem(spec, self.modes, "modal", rotary=self.rotary_inertia)
+        nodes = spec_nodes(spec, points)
+        problem = modes_problem(spec, self.modes, "modal", nodes, self.rotary_inertia)
         if problem:
             yield "modes", problem
 

@@ -8,29 +8,38 @@ inertia). Shift-and-invert converges the finite eigenvalues only: asking SLEPc f
 there are ends in a breakdown (288 of 340 pairs on a clamped 16 x P3 cantilever of 343
 unknowns: 48 free nodes x 6 dofs with mass). The count here is
 
-    (free nodes) x (dofs per node with mass) − (those fixed by Dirichlet supports)
+    (nodes) x (dofs per node with mass) − (those fixed by Dirichlet supports)
 
-with the nodes of the scene's beams, an upper estimate before the mesh exists (beams that
-share a point share its node) and exact after (:func:`free_dofs_of` with the built model's
-node count). So a refusal on reading never refuses a scene the solver could have taken.
+with the nodes of the mesh the model builder makes, counted when the scene is read
+(:func:`spec_nodes`: the vertices at named points and joints, shared vertices merged, as
+:func:`beamfx.geometry.mesh.build_mesh` does) and again on the built mesh (:func:`mesh_nodes`).
+It is exact for a clamped beam, and an upper bound where it cannot know which dofs have mass
+(a single rotation fixed with ``rotary_inertia = "polar"``): so a refusal never refuses a
+scene the solver could have taken.
 """
 
 from typing import NamedTuple
 
 from ..spec import DOF_NAMES, resolve_point
 from ..spec.model import beam_index
+from .checks import named_breaks
 from .dofs import OUT_OF_PLANE
 
 #: rotational dofs per node with rotary inertia, per ``rotary_inertia`` of a modal analysis
 ROTARY_DOFS = {"full": 3, "polar": 1, "none": 0}
 
 
-def spec_nodes(spec):
-    """Nodes of the scene's beams at most (the mesh has the highest degree everywhere, a
-    vertex at every kink; joined beams share nodes, so the mesh may have fewer)."""
-    degree = max(b.degree for b in spec.beams)
-    cells = sum(max(b.elements, len(b.curve.kinks) + 1) for b in spec.beams)
-    return cells * degree + len(spec.beams)
+def spec_nodes(spec, points=()):
+    """Nodes of the mesh the model builder makes of ``spec`` (a vertex at every named point,
+    ``points`` too: the probes; joined beams sharing one), counted without building it."""
+    from ..geometry import BeamSpec
+    from ..geometry.mesh import node_count
+
+    breaks = named_breaks(spec, points)[1]
+    specs = [
+        BeamSpec(b.name, b.curve, b.elements, tuple(breaks[i])) for i, b in enumerate(spec.beams)
+    ]
+    return node_count(specs, max(b.degree for b in spec.beams))
 
 
 def _fixed(spec):
@@ -62,9 +71,10 @@ class Count(NamedTuple):
         return max(self.nodes * self.per_node + self.extra - self.fixed, 0)
 
 
-def count_dofs(spec, nodes=None, rotary=None):
+def count_dofs(spec, nodes, rotary=None):
     """The :class:`Count` of the model ``spec`` (:class:`~beamfx.spec.Model`) with ``nodes``
-    nodes (None: :func:`spec_nodes`): its nodal dofs with mass less the fixed ones.
+    nodes (:func:`spec_nodes`, :func:`mesh_nodes`): its nodal dofs with mass less the fixed
+    ones.
 
     ``rotary``: a modal analysis's ``rotary_inertia`` (:data:`ROTARY_DOFS`; a point mass with
     rotary inertia gives its node all its rotations); None: every nodal dof counts (the
@@ -72,7 +82,6 @@ def count_dofs(spec, nodes=None, rotary=None):
     rotations have mass, fixed rotations count only where all are fixed (which of them have
     mass depends on the section axes: the bound stays an upper one).
     """
-    nodes = spec_nodes(spec) if nodes is None else nodes
     plane = spec.kinematics.plane
     names = DOF_NAMES if not plane else tuple(n for n in DOF_NAMES if n not in OUT_OF_PLANE[plane])
     turns = 1 if plane else 3  # rotations per node
@@ -93,25 +102,23 @@ def count_dofs(spec, nodes=None, rotary=None):
     return Count(nodes, len(names) - turns + moving, extra, fixed)
 
 
-def free_dofs_of(spec, nodes=None, rotary=None):
+def free_dofs_of(spec, nodes, rotary=None):
     """The most finite eigenvalues of ``spec`` (:func:`count_dofs`)."""
     return count_dofs(spec, nodes, rotary).total
 
 
-def modes_problem(spec, modes, what, nodes=None, rotary=None):
-    """Why ``modes`` is too many for ``spec`` (a message for ``[analysis] modes``), or None.
-    ``what``: the analysis's name; ``nodes``: the built mesh's (None: before it exists)."""
+def modes_problem(spec, modes, what, nodes, rotary=None):
+    """Why ``modes`` is too many for ``spec`` with ``nodes`` nodes (a message for
+    ``[analysis] modes``), or None. ``what``: the analysis's name."""
     c = count_dofs(spec, nodes, rotary)
     if modes <= c.total:
         return None
-    at_most = "" if nodes is not None else "at most "
     kind = f"dofs with mass (rotary_inertia = {rotary!r})" if rotary is not None else "dofs"
     extra = f" + {c.extra}" if c.extra else ""
     return (
-        f"= {modes}: more than a {what} analysis can find: the model has {at_most}{c.total} "
-        f"free dofs with a finite eigenvalue ({at_most}{c.nodes} nodes x {c.per_node} {kind}"
-        f"{extra} − {c.fixed} fixed by the supports); allowed: an integer in [1, {c.total}] "
-        "(or refine the mesh)"
+        f"= {modes}: more than a {what} analysis can find: the model has {c.total} free dofs "
+        f"with a finite eigenvalue ({c.nodes} nodes x {c.per_node} {kind}{extra} − {c.fixed} "
+        f"fixed by the supports); allowed: an integer in [1, {c.total}] (or refine the mesh)"
     )
 
 

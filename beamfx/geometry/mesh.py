@@ -78,6 +78,19 @@ def _nodes_and_cells(specs, degree, tol, breaks=None):
     return np.array(pts, float), np.array(cells, np.int64), np.array(beam_of), np.array(spans)
 
 
+def node_count(specs, degree):
+    """The nodes of the mesh :func:`build_mesh` makes of ``specs`` at ``degree`` (shared
+    vertices merged as it merges them), without building it (NumPy only)."""
+    tol = tolerance(specs)
+    keys, cells = set(), 0
+    for spec in specs:
+        s_v = _element_breaks(spec)
+        cells += len(s_v) - 1
+        rounded = np.round(np.asarray(spec.curve.points(s_v), float) / tol).astype(np.int64)
+        keys.update(map(tuple, rounded))
+    return len(keys) + cells * (degree - 1)
+
+
 def tolerance(specs):
     """The distance under which two mesh vertices are one (1e-9 of the model's size)."""
     size = max(np.ptp(np.vstack([s.curve.points([0, s.curve.length]) for s in specs])), 1.0)

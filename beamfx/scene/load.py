@@ -110,6 +110,9 @@ def parse_scene(data: dict, file: str = "<scene>", base: Path = Path(".")) -> Sc
     accuracy_table = top.table("accuracy", None)
     top.done()
     _check_points(model, probes, file, data.get("loads", []))
+    points = (*probes.values(), *getattr(settings, "points", tuple)())
+    for key, message in getattr(settings, "problems_on_mesh", lambda m, p: ())(model, points):
+        at.fail(key, message)  # e.g. more modes than the mesh has dofs
     _check_histories(model, settings, file, data.get("loads", []))
     if not model.supports and not takes_free_body(settings, model):
         raise SceneError(

@@ -37,15 +37,19 @@ def spec(elements=16, degree=3, more="", analysis="", modes=1):
     return parse_scene(tomllib.loads(text), "my.toml").model
 
 
+def free(model, rotary=None):
+    return free_dofs_of(model, spec_nodes(model), rotary)
+
+
 def test_a_clamped_cantilever_has_six_per_free_node():
     """16 x P3: 49 nodes, 343 unknowns (7 per node: the quaternion's fourth has no mass); the
     clamp takes one node: 48 x 6 = 288, the pairs SLEPc converged when asked for 340."""
     model = spec()
     assert spec_nodes(model) == 49
-    assert free_dofs_of(model, rotary="full") == 288
-    assert free_dofs_of(model) == 288  # buckling: every nodal dof
-    assert count_dofs(model, rotary="none") == (49, 3, 0, 3)
-    assert free_dofs_of(model, rotary="polar") == 48 * 4  # the clamp fixes the polar one too
+    assert free(model, "full") == 288
+    assert free(model) == 288  # buckling: every nodal dof
+    assert count_dofs(model, 49, "none") == (49, 3, 0, 3)
+    assert free(model, "polar") == 48 * 4  # the clamp fixes the polar one too
 
 
 def test_point_masses_releases_and_local_supports():
@@ -53,18 +57,18 @@ def test_point_masses_releases_and_local_supports():
     in local axes is a spring (its dofs stay unknowns); a second support at the same point
     fixes nothing twice."""
     mass = '\n[[masses]]\nat = "b:end"\nmass = 1.0\ninertia = [1e-3, 1e-3, 1e-3]\n'
-    assert free_dofs_of(spec(more=mass), rotary="none") == 48 * 3 + 3
+    assert free(spec(more=mass), "none") == 48 * 3 + 3
     local = '\n[[supports]]\nat = "b:end"\nfix = ["uy"]\naxes = "local"\n'
-    assert free_dofs_of(spec(more=local), rotary="full") == 288
+    assert free(spec(more=local), "full") == 288
     twice = '\n[[supports]]\nat = "b:start"\nfix = ["ux", "uy"]\n'
-    assert free_dofs_of(spec(more=twice), rotary="full") == 288
+    assert free(spec(more=twice), "full") == 288
 
 
 def test_the_planar_model_has_three_per_node():
     """[model] plane = "xy": ux, uy, rz per node; "polar" leaves rz (a bending axis) no mass."""
     model = spec(more='\n[model]\nplane = "xy"\n')
-    assert free_dofs_of(model, rotary="full") == 48 * 3
-    assert free_dofs_of(model, rotary="polar") == 48 * 2
+    assert free(model, "full") == 48 * 3
+    assert free(model, "polar") == 48 * 2
 
 
 def test_modes_beyond_the_count_are_refused_with_the_count():
@@ -74,6 +78,52 @@ def test_modes_beyond_the_count_are_refused_with_the_count():
     assert message.startswith("my.toml: analysis.modes = 13: more than a modal analysis")
     assert "5 nodes x 3 dofs with mass (rotary_inertia = 'none') − 3 fixed" in message
     assert "allowed: an integer in [1, 12]" in message
+
+
+FRAME = BEAM.replace(
+    "[[supports]]",
+    """[[beams]]
+name = "post"
+curve = {{ shape = "line", start = [0.3, 0, 0], end = [0.3, 0, 1] }}
+section = {{ type = "circle", d = 0.02 }}
+elements = 2
+degree = 1
+
+[[beams]]
+name = "arm"
+curve = {{ shape = "line", start = [1, 0, 0], end = [1, 1, 0] }}
+section = {{ type = "circle", d = 0.02 }}
+elements = 1
+degree = 1
+
+[[probes]]
+name = "p"
+at = "arm:0.5"
+
+[[supports]]""",
+)
+
+
+def test_the_count_on_reading_is_the_built_mesh_s():
+    """Joined beams share a node (arm), a T-joint (post on b at s = 0.3) and a probe (arm's
+    middle) put a vertex in: the nodes counted on reading are those of the mesh built."""
+    from mpi4py import MPI
+
+    from beamfx.analyses.mode_count import mesh_nodes
+    from beamfx.analyses.planar_condensed import build_model
+
+    text = FRAME.format(elements=2, degree=2, more="", analysis="", modes=1)
+    scene = parse_scene(tomllib.loads(text), "my.toml")
+    # b: its 2 cells split at the T-joint (s = 0.3), 5 nodes at P2; post: 2 cells, its foot
+    # on b: +4; arm: 1 element but 2 cells (a vertex at the probe), its start on b's end: +4
+    assert spec_nodes(scene.model, tuple(scene.probes.values())) == 13
+    model = build_model(scene.model, MPI.COMM_WORLD, list(scene.probes.values()), False)
+    assert mesh_nodes(model) == 13
+    assert free_dofs_of(scene.model, 13) == 13 * 6 - 6
+    parse_scene(tomllib.loads(FRAME.format(elements=2, degree=2, more="", analysis="", modes=72)))
+    text = FRAME.format(elements=2, degree=2, more="", analysis="", modes=73)
+    with pytest.raises(SceneError, match=r"analysis\.modes = 73: .*\(13 nodes x 6 dofs"):
+        parse_scene(tomllib.loads(text))
 
 
 def test_the_nearest_in_hz_are_proven_only_when_the_pairs_reach_far_enough():
