@@ -118,10 +118,16 @@ def _check(args):
 
     scene = check_scene(args.scene)
     if hasattr(scene, "members"):
-        first = scene.members[0].scene
+        first, n, checked = scene.members[0].scene, len(scene.members), len(scene.validated)
+        which = (
+            "every member checked"
+            if checked == n
+            else f"{checked} members checked, each value once; 'beamfx run' checks every "
+            "member before it solves any"
+        )
         print(
-            f"{args.scene}: OK (a sweep of {len(scene.members)} scenes over "
-            f"{', '.join(scene.keys)}; analysis {first.analysis})"
+            f"{args.scene}: OK (a sweep of {n} scenes over {', '.join(scene.keys)}; analysis "
+            f"{first.analysis}; {which})"
         )
     else:
         n = len(scene.model.beams)

@@ -21,8 +21,9 @@ members is read in a fraction of a second. When the file is read, the members ar
 tables at their first values; so a bad value is reported before anything is solved. A bad
 combination of good values (elements of one table and degree of another beyond
 ``max_unknowns``, or modes of one beyond the dofs of another's mesh) in a large sweep is
-found by ``beamfx check`` and ``beamfx run``, which build every member before any solve
-(:func:`beamfx.runner.check_members`, about 2 ms a member), and refused naming the member.
+found by ``beamfx run``, which builds every member before any solve
+(:func:`beamfx.runner.check_members`, 2-5 ms a member), and by ``beamfx check`` up to
+:data:`beamfx.runner.CHECK_EVERY_MEMBER` members, and refused naming the member.
 """
 
 import copy
