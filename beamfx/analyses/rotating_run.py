@@ -66,6 +66,16 @@ class Settings:
         """The hub defaults to the first support's point."""
         return {"hub": model.supports[0].at} if model.supports else {}
 
+    def problems_on_mesh(self, spec: Model, points: tuple) -> Iterator[tuple[str, str]]:
+        """No more modes than the free dofs with mass of the mesh (:mod:`.mode_count`): the
+        undamped gyroscopic problem has a pair ±iω per such dof."""
+        from .mode_count import modes_problem, spec_nodes
+
+        nodes = spec_nodes(spec, points)
+        problem = modes_problem(spec, self.modes, "rotating", nodes, self.rotary_inertia)
+        if problem:
+            yield "modes", problem
+
     def problems_in(self, model: Model) -> Iterator[tuple[str, str]]:
         """A named hub must be a point of the model (coordinates may lie anywhere)."""
         from ..spec import resolve_point

@@ -142,3 +142,14 @@ def test_the_nearest_in_hz_are_proven_only_when_the_pairs_reach_far_enough():
     hz = [65.0, 129.0, 21.0, 10.0, 182.0]
     keep, proven = nearest_in_hz(hz, lam(hz), 3, 100.0)
     assert [hz[i] for i in keep] == [129.0, 65.0, 21.0] and proven
+
+
+def test_a_rotating_analysis_is_bounded_by_the_same_count():
+    """The built-in rotating strip (16 x P3, clamped): 288 modes per speed at most."""
+    from beamfx.runner import default_scene_path
+
+    text = (default_scene_path().parent / "pai_rotating.toml").read_text()
+    assert "\nmodes = 4\n" in text
+    parse_scene(tomllib.loads(text.replace("\nmodes = 4\n", "\nmodes = 288\n")), "r.toml")
+    with pytest.raises(SceneError, match=r"r\.toml: analysis\.modes = 289: more than a rotating"):
+        parse_scene(tomllib.loads(text.replace("\nmodes = 4\n", "\nmodes = 289\n")), "r.toml")
