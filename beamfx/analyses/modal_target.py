@@ -35,9 +35,18 @@ def solve_nearest_hz(solve, n, target_hz, most):
     """The :class:`~.modal.ModalResult` of the ``n`` modes nearest ``target_hz`` in Hz, nearest
     first. ``solve(m)``: the ``m`` modes nearest in ω² (a ModalResult); ``most``: the finite
     eigenvalues there are (asking for all of them is exact)."""
+    from ..solvers import SolveFailed
+
     m, spent = min(n + max(EXTRA, n), most), {}
     while True:
-        res = solve(m)
+        try:
+            res = solve(m)
+        except SolveFailed as e:  # fewer finite eigenvalues than the count (an upper bound)
+            found = (getattr(e, "details", None) or {}).get("converged", 0)
+            if m == n or not n <= found < m:
+                raise
+            m = most = found  # all there are: asking for them is exact
+            continue
         for key, value in res.seconds.items():  # every try's time counts
             spent[key] = spent.get(key, 0.0) + value
         keep, proven = nearest_in_hz(res.hz, res.eigenvalues, n, target_hz)

@@ -153,3 +153,30 @@ def test_a_rotating_analysis_is_bounded_by_the_same_count():
     parse_scene(tomllib.loads(text.replace("\nmodes = 4\n", "\nmodes = 288\n")), "r.toml")
     with pytest.raises(SceneError, match=r"r\.toml: analysis\.modes = 289: more than a rotating"):
         parse_scene(tomllib.loads(text.replace("\nmodes = 4\n", "\nmodes = 289\n")), "r.toml")
+
+
+def test_when_the_count_overestimates_the_modes_all_found_are_taken():
+    """A model with 15 finite modes counted 16 (polar inertia, a single rotation fixed):
+    asking for 16 to find the 8 nearest in Hz fails with 15 converged; those are all there
+    are, so they are asked for and the answer is exact (not a failure: the user asked 8)."""
+    from beamfx.analyses.modal import ModalResult
+    from beamfx.analyses.modal_target import solve_nearest_hz
+    from beamfx.solvers import SolveFailed
+
+    spectrum = np.array([1.0, 2.0, 3.0, 5.0, 8.0, 13.0, 21.0, 34.0, 55.0, 89.0, 144.0, 233.0])
+    spectrum = np.r_[spectrum, 377.0, 610.0, 987.0]  # 15 modes (Hz)
+    asked = []
+
+    def solve(m):
+        asked.append(m)
+        if m > len(spectrum):
+            raise SolveFailed("too few", details={"requested": m, "converged": len(spectrum)})
+        lam = (2 * np.pi * spectrum) ** 2
+        order = np.argsort(np.abs(lam - (2 * np.pi * 30.0) ** 2), kind="stable")[:m]
+        hz = spectrum[order]
+        return ModalResult(lam[order], 2 * np.pi * hz, hz, tuple(hz), 0 * hz, {"solve": 1.0})
+
+    res = solve_nearest_hz(solve, 8, 30.0, 16)
+    assert asked == [16, 15]
+    expected = spectrum[np.argsort(np.abs(spectrum - 30.0), kind="stable")[:8]]
+    assert list(res.hz) == list(expected) and res.seconds == {"solve": 1.0}
