@@ -201,4 +201,3 @@ def test_every_member_of_a_large_sweep_is_checked_before_any_solve(tmp_path, cap
         if MPI.COMM_WORLD.rank == 0:
             assert "(sweep member 9: beams.b.elements = 1, analysis.modes = 30)" in err
     assert not (folder / "out").exists()
-
