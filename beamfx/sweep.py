@@ -83,7 +83,7 @@ def run_sweep(sweep, out_dir, run_scene, log=None, comm=None, **options):
     from .io.folder import check_output_dir
 
     comm = comm or MPI.COMM_WORLD
-    log = log or partial(default_log, comm=comm)
+    given, log = log, log or partial(default_log, comm=comm)
     out = Path(out_dir or sweep.output_dir)
     check_output_dir(out, sweep.file if out_dir is None else None)
     check_writable(out, comm)
@@ -103,8 +103,11 @@ def run_sweep(sweep, out_dir, run_scene, log=None, comm=None, **options):
     for member in sweep.members[color[comm.rank] :: groups]:
         tag = f"[member {member.index}/{n}] "
 
-        def member_log(msg, tag=tag):
-            default_log(tag + msg, comm=group)
+        def member_log(msg, tag=tag):  # the caller's sink, else printed by the group's rank 0
+            if given is None:
+                default_log(tag + msg, comm=group)
+            elif group.rank == 0:
+                given(tag + msg)
 
         folder = out / f"member_{member.index:03d}"
         row = _solve_member(member, folder, group, member_log, run_scene, **options)

@@ -125,9 +125,13 @@ def test_sweep_rows_are_the_members_own_runs(tmp_path):
             base=base,
         )
     )
-    table = run_scene(path, tmp_path / "out")
+    lines = []
+    table = run_scene(path, tmp_path / "out", log=lines.append)
     rows = table["members"]
     assert [r["status"] for r in rows] == ["converged", "failed"] * 2
+    # the caller's log gets every member's lines, tagged (none printed past it)
+    for i in range(4):
+        assert any(line.startswith(f"[member {i}/4] ") for line in lines), i
     assert "DIVERGED_MAX_IT" in rows[1]["reason"]
     for row, force in zip(rows[::2], (300, 600)):
         single = tmp_path / f"alone_{force}.toml"
