@@ -197,3 +197,26 @@ def run_whole_and_restarted(folder, whole, short):
         np.genfromtxt(folder / name / "probes.csv", delimiter=",", names=True)
         for name in ("whole", "parts")
     )
+
+
+# a clamped 1 m steel rod of 2 x P2 elements, modal with 30 modes: more than it has
+MODAL_ROD = """
+[material]
+E = 210e9
+rho = 7850
+
+[[beams]]
+name = "b"
+curve = { shape = "line", start = [0, 0, 0], end = [1, 0, 0] }
+section = { type = "circle", d = 0.02 }
+elements = 2
+degree = 2
+
+[[supports]]
+at = "b:start"
+fix = "all"
+
+[analysis]
+type = "modal"
+modes = 30
+"""

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
+from scenekit import MODAL_ROD
 
 from beamfx.cli import main
 
@@ -107,30 +108,14 @@ def test_fewer_buckling_factors_than_asked_are_returned_with_a_note(tmp_path, ca
     assert results["note"].startswith(f"found {found} of the 36 buckling load factors asked")
 
 
-SWEEP = """
-[material]
-E = 210e9
-rho = 7850
-
-[[beams]]
-name = "b"
-curve = { shape = "line", start = [0, 0, 0], end = [1, 0, 0] }
-section = { type = "circle", d = 0.02 }
-elements = 8
-degree = 2
-
-[[supports]]
-at = "b:start"
-fix = "all"
-
-[analysis]
-type = "modal"
-modes = 30
-
+SWEEP = (
+    MODAL_ROD.replace("elements = 2", "elements = 8")
+    + """
 [[sweep]]
 key = ["beams.b.elements", "beams.b.degree"]
 values = [[8, 2], [1, 1]]
 """
+)
 
 
 def test_a_sweep_member_with_too_many_modes_is_named_before_any_solve(tmp_path, capsys):

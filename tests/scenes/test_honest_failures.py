@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mpi4py import MPI
+from scenekit import MODAL_ROD
 
 from beamfx.cli import main
 from beamfx.solvers.convergence import REMEDIES
@@ -42,26 +43,7 @@ type = "static"
 steps = 10
 """
 
-MODAL = """
-[material]
-E = 210e9
-rho = 7850
-
-[[beams]]
-name = "b"
-curve = { shape = "line", start = [0, 0, 0], end = [1, 0, 0] }
-section = { type = "circle", d = 0.02 }
-elements = 2
-degree = 2
-
-[[supports]]
-at = "b:start"
-fix = "all"
-
-[analysis]
-type = "modal"
-modes = 30
-"""
+MODAL = MODAL_ROD
 
 ROTATING = """
 [material]
