@@ -50,6 +50,16 @@ def _gauss(points):
     return np.polynomial.legendre.leggauss(points)
 
 
+def composite_gauss(points, parts):
+    """The composite Gauss rule on [0, 1]: ``parts`` equal parts, ``points`` Gauss points in
+    each; (points, weights summing to 1), flat. The centre line's quadrature from vertex 0 to
+    a node ξ_j uses it scaled by ξ_j (compiled, :meth:`CondensedModel._quadrature_increments`,
+    or in NumPy, :func:`~beamfx.analyses.planar_condensed.gauss_increments`)."""
+    gx, gw = _gauss(points)
+    local = (np.arange(parts)[:, None] + (gx[None, :] + 1) / 2) / parts
+    return local.ravel(), np.tile(gw / 2, parts) / parts
+
+
 def left_jacobian(g):
     """J(ψ) = I + (1 − cos θ)/θ² ψ̂ + (θ − sin θ)/θ³ ψ̂² (θ = |ψ|): the spatial virtual
     rotation δθ = axial(δR Rᵀ) = J δψ of R = exp(ψ̂) (NumPy, one vector; Taylor series of
@@ -385,16 +395,14 @@ class CondensedModel(Discretised):
         cache = self._integrator = self._integrator or {}
         moved = xi != 0  # the nodes integrated to
         if subintervals not in cache:
-            gx, gw = _gauss(self.degree + 2)
-            local = (np.arange(subintervals)[:, None] + (gx[None, :] + 1) / 2) / subintervals
-            points = (xi[moved, None] * local.ravel()[None, :]).reshape(-1, 1)
+            local, weights = composite_gauss(self.degree + 2, subintervals)
+            points = (xi[moved, None] * local[None, :]).reshape(-1, 1)
             x_xi = ufl.Jacobian(m)[:, 0]  # dX/dξ = |J| t0: u_ξ = |J| (t0·t_s) u'
             sign = ufl.dot(self.t_s, self.discretisation.t0)
             u_xi = sign * ufl.sqrt(ufl.dot(x_xi, x_xi)) * (self.x_dot - self.t_s)
             expr = fem.Expression(
                 u_xi, points, form_compiler_params=EXACT_TABLES, jit_params=dict(JIT_PARAMS)
             )
-            weights = np.tile(gw / 2, subintervals) / subintervals
             cells = np.arange(m.topology.index_map(1).size_local, dtype=np.int32)
             cache[subintervals] = (expr, weights, cells, int(np.count_nonzero(moved)))
         expr, gw, cells, k = cache[subintervals]

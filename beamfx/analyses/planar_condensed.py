@@ -28,7 +28,7 @@ from mpi4py import MPI
 
 from ..physics import condensed as rod
 from ..physics.kinematics import PLANES, plane_normal
-from .condensed import CondensedModel, _gauss
+from .condensed import CondensedModel, composite_gauss
 
 #: largest turn of θ in one part of a cell in the quadrature of the centre line (radians):
 #: p + 2 Gauss points per part then integrate cos θ and sin θ to about 1e-16
@@ -107,9 +107,7 @@ def _gauss_rule(xi, parts):
     (len(ξ) · points, len(ξ))) of the composite Gauss rule on [0, ξ_j] (read only)."""
     from ..io._sections import lagrange_matrix
 
-    gx, gw = _gauss(len(xi) + 1)  # p + 2 points
-    local = ((np.arange(parts)[:, None] + (gx[None, :] + 1) / 2) / parts).ravel()
-    weights = np.tile(gw / 2, parts) / parts
+    local, weights = composite_gauss(len(xi) + 1, parts)  # p + 2 points a part
     nodes = np.asarray(xi)
     basis = np.concatenate([lagrange_matrix(nodes, xj * local) for xj in nodes])
     for a in (weights, basis):
