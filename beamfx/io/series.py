@@ -83,6 +83,16 @@ class PvdIndex:
         return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
 
 
+def kept_until(t_max, inclusive=True):
+    """``keep(t)``: whether a frame at time ``t`` of an earlier run stays on a restart at
+    ``t_max`` (relative tolerance 1e-12; the frame at ``t_max`` too if ``inclusive``), for
+    every series (VTK here, XDMF in :mod:`beamfx.io.xdmf`)."""
+    if inclusive:
+        top = t_max * (1 + 1e-12) + 1e-300
+        return lambda t: t <= top
+    return lambda t: t < t_max * (1 - 1e-12)
+
+
 class VtkSeries:
     """A time series ``<stem>.pvd`` of frames ``<stem>_NNNN.vtu`` (one rank) or
     ``<stem>_NNNN.pvtu`` with a piece ``<stem>_NNNN_R.vtu`` per rank. Collective methods.
@@ -123,10 +133,7 @@ class VtkSeries:
     def resume(self, t_max, inclusive=True):
         """Keep the frames up to ``t_max`` (relative tolerance 1e-12) of an earlier run; the
         one at ``t_max`` too if ``inclusive``."""
-        if inclusive:
-            self._start(lambda t: t <= t_max * (1 + 1e-12) + 1e-300)
-        else:
-            self._start(lambda t: t < t_max * (1 - 1e-12))
+        self._start(kept_until(t_max, inclusive))
 
     def write(self, step, time, grid):
         """Frame number ``step`` at ``time``: this rank's piece ``grid``; on a first frame the

@@ -27,6 +27,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from .series import kept_until
+
 XINCLUDE = "http://www.w3.org/2001/XInclude"
 
 
@@ -125,15 +127,15 @@ def _resume_file(path, t_max, inclusive):
             raise OSError(f"{os.path.basename(h5)} is missing")
     except (ET.ParseError, OSError, ValueError, AttributeError) as e:
         return "w", _set_aside(path, stem, h5, e)
-    top = t_max * (1 + 1e-12) + 1e-300
-    keep = (lambda t: t <= top) if inclusive else (lambda t: t < t_max * (1 - 1e-12))
+    keep = kept_until(t_max, inclusive)
     if not any(keep(t) for _, _, t in frames):  # nothing to keep: replaced at the first frame
         return "w", None  # (the condensed model's frames when the full one takes over)
     for parent, grid, t in frames:
         if not keep(t):
             parent.remove(grid)
     note = None
-    if any(t > top for _, _, t in frames):  # their data sets hold the restart's names
+    after = kept_until(t_max)  # (the frames after the checkpoint)
+    if any(not after(t) for _, _, t in frames):  # their data sets hold the restart's names
         part = _free_part(stem)
         _point_at(tree, os.path.basename(h5), os.path.basename(part))
         os.replace(h5, part)
