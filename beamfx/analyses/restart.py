@@ -8,15 +8,13 @@ file and the ranks agree: a missing or damaged file, another scene (its differen
 or another mesh stop every rank with one message, before anything is solved.
 """
 
-import os
-import re
-
 import numpy as np
 
 from ..io.checkpoint import (
     CheckpointError,
     agree,
     checkpoint_path,
+    checkpoint_ranks,
     read_checkpoints,
     write_checkpoint,
 )
@@ -51,24 +49,6 @@ def checkpoint_writer(ctx, settings, model, history):
         write_checkpoint(path, {**full, "ranks": ctx.comm.size, "rank": ctx.comm.rank}, arrays)
 
     return write
-
-
-#: the name of a checkpoint file (:func:`~beamfx.io.checkpoint.checkpoint_path`)
-_CHECKPOINT = re.compile(r"checkpoint_(\d+)ranks_(\d+)\.npz")
-
-
-def checkpoint_ranks(folder):
-    """{number of ranks: [file names]} of the checkpoints in ``folder`` (none if missing)."""
-    try:
-        names = sorted(os.listdir(folder))
-    except OSError:
-        return {}
-    found = {}
-    for name in names:
-        match = _CHECKPOINT.fullmatch(name)
-        if match:
-            found.setdefault(int(match[1]), []).append(name)
-    return found
 
 
 def refuse_other_ranks(folder, comm):

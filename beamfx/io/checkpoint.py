@@ -16,6 +16,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import zipfile
 from pathlib import Path
 
@@ -33,6 +34,24 @@ class CheckpointError(ValueError):
 def checkpoint_path(folder, ranks, rank):
     """The checkpoint file of ``rank`` of a run on ``ranks`` ranks in ``folder``."""
     return Path(folder) / f"checkpoint_{ranks}ranks_{rank}.npz"
+
+
+#: the name :func:`checkpoint_path` gives (ranks, rank)
+CHECKPOINT_NAME = re.compile(r"checkpoint_(\d+)ranks_(\d+)\.npz")
+
+
+def checkpoint_ranks(folder):
+    """{number of ranks: [file names]} of the checkpoints in ``folder`` (none if missing)."""
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return {}
+    found = {}
+    for name in names:
+        match = CHECKPOINT_NAME.fullmatch(name)
+        if match:
+            found.setdefault(int(match[1]), []).append(name)
+    return found
 
 
 def _digest(a):
