@@ -28,7 +28,7 @@ import ufl
 from mpi4py import MPI
 
 from ..physics import condensed as rod
-from ..physics.rotations import np_exp_rotation, np_hat
+from ..physics.rotations import np_exp_rotation, np_left_jacobian
 from ..spec import resolve_point
 from .discretisation import Discretised, discretise
 from .dofs import constrained_dofs, global_size, owned_size
@@ -58,19 +58,6 @@ def composite_gauss(points, parts):
     gx, gw = _gauss(points)
     local = (np.arange(parts)[:, None] + (gx[None, :] + 1) / 2) / parts
     return local.ravel(), np.tile(gw / 2, parts) / parts
-
-
-def left_jacobian(g):
-    """J(ψ) = I + (1 − cos θ)/θ² ψ̂ + (θ − sin θ)/θ³ ψ̂² (θ = |ψ|): the spatial virtual
-    rotation δθ = axial(δR Rᵀ) = J δψ of R = exp(ψ̂) (NumPy, one vector; Taylor series of
-    both factors below θ = 1e-4)."""
-    W = np_hat(g)
-    theta = float(np.linalg.norm(g))
-    if theta < 1e-4:
-        a, b = 0.5 - theta**2 / 24, 1 / 6 - theta**2 / 120
-    else:
-        a, b = (1 - np.cos(theta)) / theta**2, (theta - np.sin(theta)) / theta**3
-    return np.eye(3) + a * W + b * (W @ W)
 
 
 class RotationRangeError(ValueError):
@@ -263,12 +250,13 @@ class CondensedModel(Discretised):
         """The moment (global axes) that the point load ``ld``'s moment exerts at the nodal
         unknowns ``g`` of its point (NumPy), the one :meth:`_moment_work` does work with:
         dead M, follower R M, semitangential J⁻ᵀ M (potential M·ψ, ψ = g; δθ = J δψ with J
-        the left Jacobian of exp, :func:`left_jacobian`), all times the load factor."""
+        the left Jacobian of exp, :func:`~beamfx.physics.rotations.np_left_jacobian`), all
+        times the load factor."""
         M = float(self.load_factor.value) * np.asarray(ld.moment, float)
         if ld.kind == "follower":
             return self.np_rotation(g) @ M
         if ld.kind == "semitangential":
-            return np.linalg.solve(left_jacobian(g).T, M)
+            return np.linalg.solve(np_left_jacobian(g).T, M)
         return M
 
     # --- forms ------------------------------------------------------------------------------

@@ -116,6 +116,19 @@ def np_exp_rotation(theta):
     return np.eye(3) + c1 * W + c2 * (W @ W)
 
 
+def np_left_jacobian(g):
+    """J(ψ) = I + (1 − cos θ)/θ² ψ̂ + (θ − sin θ)/θ³ ψ̂² (θ = |ψ|): the spatial virtual
+    rotation δθ = axial(δR Rᵀ) = J δψ of R = exp(ψ̂) (NumPy, one vector; Taylor series of
+    both factors below θ = 1e-4)."""
+    W = np_hat(g)
+    theta = float(np.linalg.norm(g))
+    if theta < 1e-4:
+        a, b = 0.5 - theta**2 / 24, 1 / 6 - theta**2 / 120
+    else:
+        a, b = (1 - np.cos(theta)) / theta**2, (theta - np.sin(theta)) / theta**3
+    return np.eye(3) + a * W + b * (W @ W)
+
+
 def np_quaternion(axis, angle):
     """Unit quaternion of a rotation by ``angle`` about ``axis``."""
     axis = np.asarray(axis, dtype=float)

@@ -17,12 +17,13 @@ from scenekit import CONDENSED_LOADS
 from test_reaction_output import csv_rows
 from test_reactions import _quiet
 
-from beamfx.analyses.condensed import CondensedModel, left_jacobian
+from beamfx.analyses.condensed import CondensedModel
 from beamfx.analyses.condensed_reactions import load_resultant
 from beamfx.analyses.model import BeamModel
 from beamfx.analyses.reactions import Reaction, entries, load_balance
 from beamfx.analyses.static import solve_static
 from beamfx.bench.output_cost import ROLLUP
+from beamfx.physics.rotations import np_left_jacobian as left_jacobian
 from beamfx.runner import run_scene
 from beamfx.scene.load import parse_scene
 
