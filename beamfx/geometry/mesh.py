@@ -51,6 +51,12 @@ def _element_breaks(spec):
     )
 
 
+def _vertex_keys(xyz, tol):
+    """The keys under which vertices at the points ``xyz`` (n, 3) are one node: their
+    coordinates rounded to ``tol`` (:func:`tolerance`), as tuples."""
+    return list(map(tuple, np.round(np.asarray(xyz, float) / tol).astype(np.int64)))
+
+
 def _nodes_and_cells(specs, degree, tol, breaks=None):
     """Rank-0 node coordinates, cells (DOLFINx order), beam of each cell and its (s_a, s_b);
     ``breaks``: :func:`_element_breaks` of each spec, if known."""
@@ -58,7 +64,7 @@ def _nodes_and_cells(specs, degree, tol, breaks=None):
     vertex_ids = {}  # rounded coordinate -> node index, merges shared vertices
 
     def vertex(x):
-        key = tuple(np.round(np.asarray(x) / tol).astype(np.int64))
+        [key] = _vertex_keys([x], tol)
         if key not in vertex_ids:
             vertex_ids[key] = len(pts)
             pts.append(x)
@@ -80,14 +86,14 @@ def _nodes_and_cells(specs, degree, tol, breaks=None):
 
 def node_count(specs, degree):
     """The nodes of the mesh :func:`build_mesh` makes of ``specs`` at ``degree`` (shared
-    vertices merged as it merges them), without building it (NumPy only)."""
+    vertices merged by the same keys, :func:`_vertex_keys`), without building it (NumPy
+    only)."""
     tol = tolerance(specs)
     keys, cells = set(), 0
     for spec in specs:
         s_v = _element_breaks(spec)
         cells += len(s_v) - 1
-        rounded = np.round(np.asarray(spec.curve.points(s_v), float) / tol).astype(np.int64)
-        keys.update(map(tuple, rounded))
+        keys.update(_vertex_keys(spec.curve.points(s_v), tol))
     return len(keys) + cells * (degree - 1)
 
 
