@@ -70,13 +70,18 @@ def solve_and_collect(solver, A, nev, prefix, keep, least=None, asked=None):
     pair], errors, iterations); the solver is destroyed. ``asked``: what the user asked for,
     for the message (:func:`_too_few`).
 
+    Fewer than ``nev`` but at least ``least`` pairs are accepted only when SLEPc ended
+    converged (the pairs it found are all it could find); when it stopped on a divergence
+    (its iteration limit, a breakdown) the shortfall is a numerical failure.
+
     Raises:
-        SolveFailed: if fewer than ``least`` pairs converged (cause "eigen solve"; ``details``
-            holds the eigenvalues it found).
+        SolveFailed: if fewer than ``least`` pairs converged, or fewer than ``nev`` after a
+            divergence (cause "eigen solve"; ``details`` holds the eigenvalues it found).
     """
     solver.solve()
     n = solver.getConverged()
-    if n < (nev if least is None else least):
+    diverged = n < nev and solver.getConvergedReason() < 0
+    if n < (nev if least is None else least) or diverged:
         raise _too_few(solver, n, nev, prefix, asked)
     values, vectors, errors = [], [], []
     vr, vi = A.createVecs()
